@@ -1,0 +1,10 @@
+//! dda3d — three-dimensional Discontinuous Deformation Analysis of jointed rock.
+//!
+//! The solver follows Shi's 3-D DDA with normal contacts enforced by the augmented Lagrangian
+//! method of Zhang Hong (Chinese J. Geotech. Eng. 41(2), 2019), "DDA-3a"; the classic fixed-penalty
+//! scheme ("DDA-3p") is kept as a baseline. Equation numbers (P1)…(P26) refer to that paper,
+//! plain numbers such as (5.4) to `shared/docs/dda3d-reference.md`.
+//!
+//! Data flows one way: [`scene`] → [`solver`] → [`snapshot`] → renderer / [`output`].
+
+pub mod snapshot;

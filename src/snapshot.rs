@@ -1,0 +1,136 @@
+//! Plain-data pictures of the solver state, published after each completed step.
+//!
+//! Data flows one way: scene → solver → [`Snapshot`] → renderer / output files. Nothing in here
+//! refers back to the solver, so the renderer and the CSV writers depend only on this module.
+
+use serde::Serialize;
+
+/// How a contact was entered (paper Fig. 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+pub enum ContactMode {
+    /// A vertex of block i against a face of block j.
+    VertexFace,
+    /// An edge of block i against an edge of block j.
+    EdgeEdge,
+}
+
+impl ContactMode {
+    /// The name used in `contacts.csv`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ContactMode::VertexFace => "vertex-face",
+            ContactMode::EdgeEdge => "edge-edge",
+        }
+    }
+}
+
+/// Mohr–Coulomb state of a contact (reference §6.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+pub enum ContactState {
+    Open,
+    /// Closed, tangentially held by the shear spring.
+    Lock,
+    /// Closed, sliding with friction N tan φ (+ cohesion).
+    Slide,
+}
+
+impl ContactState {
+    /// The name used in `contacts.csv`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ContactState::Open => "open",
+            ContactState::Lock => "lock",
+            ContactState::Slide => "slide",
+        }
+    }
+
+    pub fn is_closed(self) -> bool {
+        self != ContactState::Open
+    }
+}
+
+/// One block at the end of a step.
+#[derive(Clone, Debug, Serialize)]
+pub struct BlockSnapshot {
+    pub name: String,
+    /// Held by vertex springs (drawn in a muted colour).
+    pub fixed: bool,
+    /// Current vertex positions, m.
+    pub vertices: Vec<[f64; 3]>,
+    /// Faces as vertex indices, counter-clockwise seen from outside (outward normal by the
+    /// right-hand rule). The topology never changes during a run.
+    pub faces: Vec<Vec<u32>>,
+    /// Centroid, m.
+    pub centroid: [f64; 3],
+    /// Centroid velocity, m/s.
+    pub velocity: [f64; 3],
+    /// Centroid displacement since t = 0, m.
+    pub displacement: [f64; 3],
+}
+
+/// One active (non-open) contact at the end of a step.
+#[derive(Clone, Debug, Serialize)]
+pub struct ContactSnapshot {
+    /// Index of the block that owns the vertex (V–F) or the first edge (E–E).
+    pub block_i: usize,
+    /// Index of the block that owns the face (V–F) or the second edge (E–E).
+    pub block_j: usize,
+    pub mode: ContactMode,
+    pub state: ContactState,
+    /// Contact point on the surface of block j, m.
+    pub point: [f64; 3],
+    /// Unit contact normal, pointing out of block j toward block i.
+    pub normal: [f64; 3],
+    /// Normal force, N, positive when compressive.
+    pub normal_force: f64,
+    /// Magnitude of the tangential (shear) force, N.
+    pub shear_force: f64,
+    /// Penetration, m, positive when the blocks overlap.
+    pub penetration: f64,
+    /// Normal penalty in effect, N/m.
+    pub penalty: f64,
+    /// Lagrange multiplier (0 in penalty mode), N.
+    pub lambda: f64,
+}
+
+/// Per-step statistics.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StepStats {
+    /// Length of the accepted step, s.
+    pub time_step: f64,
+    /// Open–close passes in the accepted attempt.
+    pub open_close_iterations: u32,
+    /// Linear solves (ALM iterations, or one per open–close pass in penalty mode) in the
+    /// accepted attempt.
+    pub alm_iterations: u32,
+    /// Attempts discarded before this step was accepted (displacement limit, open–close limit).
+    pub time_step_cuts: u32,
+    /// Numeric factorizations in this step, all attempts.
+    pub factorizations: u32,
+    /// Largest penetration over closed contacts, m.
+    pub max_penetration: f64,
+    /// Closed contacts in the lock state.
+    pub contacts_lock: u32,
+    /// Closed contacts in the slide state.
+    pub contacts_slide: u32,
+    /// Detected but open contacts.
+    pub contacts_open: u32,
+    /// Kinetic energy ½ vᵀMv over all blocks, J.
+    pub kinetic_energy: f64,
+    /// Gravitational potential energy Σ m g·(−x_c) relative to the origin, J.
+    pub potential_energy: f64,
+}
+
+/// The state of a run at the end of a completed step (step 0 is the initial state).
+#[derive(Clone, Debug, Serialize)]
+pub struct Snapshot {
+    pub scene_name: String,
+    /// Simulated time, s.
+    pub time: f64,
+    /// Completed steps.
+    pub step: u64,
+    pub blocks: Vec<BlockSnapshot>,
+    /// Closed contacts only.
+    pub contacts: Vec<ContactSnapshot>,
+    pub stats: StepStats,
+}
