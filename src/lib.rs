@@ -7,4 +7,9 @@
 //!
 //! Data flows one way: [`scene`] → [`solver`] → [`snapshot`] → renderer / [`output`].
 
+pub mod contact;
+pub mod geometry;
+pub mod linear;
+pub mod mechanics;
+pub mod params;
 pub mod snapshot;
