@@ -7,9 +7,13 @@
 //!
 //! Data flows one way: [`scene`] → [`solver`] → [`snapshot`] → renderer / [`output`].
 
+pub mod cli;
 pub mod contact;
 pub mod geometry;
 pub mod linear;
 pub mod mechanics;
+pub mod output;
 pub mod params;
+pub mod scene;
 pub mod snapshot;
+pub mod solver;

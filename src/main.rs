@@ -1,3 +1,13 @@
+use clap::Parser;
+use dda3d::cli::{self, Cli, Command};
+
 fn main() {
-    println!("dda3d: under construction");
+    let cli = Cli::parse();
+    let result = match &cli.command {
+        Command::Run(args) => cli::run(args),
+    };
+    if let Err(e) = result {
+        eprintln!("error: {}", e.message());
+        std::process::exit(e.exit_code());
+    }
 }

@@ -1,0 +1,213 @@
+//! Command-line interface: `dda3d run`, and the shared option handling.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use clap::{Args, Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use crate::output::{RunWriter, Summary, slug};
+use crate::params::{Method, Mode};
+use crate::scene::{self, Scene, SceneError};
+use crate::solver::{Solver, SolverError};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "dda3d",
+    version,
+    about = "3-D Discontinuous Deformation Analysis of jointed rock (DDA-3a)"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Simulate a scene without any window or GPU; write blocks.csv, contacts.csv, summary.json.
+    Run(RunArgs),
+}
+
+/// Overrides of the scene's `[solver]` table, shared by the commands that simulate.
+#[derive(Args, Debug, Clone, Default)]
+pub struct SolverOverrides {
+    /// Contact method: alm (DDA-3a) or penalty (DDA-3p).
+    #[arg(long, value_enum)]
+    pub method: Option<Method>,
+    /// Time integration: dynamic or static.
+    #[arg(long, value_enum)]
+    pub mode: Option<Mode>,
+    /// Simulated time, s.
+    #[arg(long)]
+    pub duration: Option<f64>,
+}
+
+#[derive(Args, Debug)]
+pub struct RunArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    #[command(flatten)]
+    pub overrides: SolverOverrides,
+    /// Output directory (default: out/<scene name as a slug>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// No progress bar and no final line.
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// How a command failed, and with which exit status.
+#[derive(Debug)]
+pub enum CliError {
+    /// Bad input: exit status 2.
+    Input(String),
+    /// The run failed (diverged, I/O): exit status 1.
+    Run(String),
+}
+
+impl CliError {
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            CliError::Input(_) => 2,
+            CliError::Run(_) => 1,
+        }
+    }
+    pub fn message(&self) -> &str {
+        match self {
+            CliError::Input(m) | CliError::Run(m) => m,
+        }
+    }
+}
+
+impl From<SceneError> for CliError {
+    fn from(e: SceneError) -> Self {
+        CliError::Input(e.to_string())
+    }
+}
+
+/// Loads a scene and applies the command-line overrides.
+pub fn load_scene(path: &Path, o: &SolverOverrides) -> Result<Scene, CliError> {
+    let mut s = scene::load(path)?;
+    if let Some(m) = o.method {
+        s.params.method = m;
+    }
+    if let Some(m) = o.mode {
+        s.params.mode = m;
+    }
+    if let Some(d) = o.duration {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(CliError::Input(format!(
+                "--duration must be a positive number of seconds, got {d}"
+            )));
+        }
+        s.params.duration = d;
+    }
+    Ok(s)
+}
+
+/// A progress bar that appears only once a run has taken more than a second.
+pub struct Progress {
+    bar: ProgressBar,
+    start: Instant,
+    shown: bool,
+    quiet: bool,
+}
+
+impl Progress {
+    pub fn new(total_seconds: f64, quiet: bool) -> Self {
+        let bar = ProgressBar::with_draw_target(
+            Some((total_seconds * 1000.0).round() as u64),
+            ProgressDrawTarget::hidden(),
+        );
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} t = {msg} s (eta {eta})",
+            )
+            .expect("valid template"),
+        );
+        Progress {
+            bar,
+            start: Instant::now(),
+            shown: false,
+            quiet,
+        }
+    }
+
+    pub fn update(&mut self, time: f64) {
+        if self.quiet {
+            return;
+        }
+        if !self.shown && self.start.elapsed() > Duration::from_secs(1) {
+            self.bar.set_draw_target(ProgressDrawTarget::stderr());
+            self.shown = true;
+        }
+        self.bar.set_position((time * 1000.0).round() as u64);
+        self.bar.set_message(format!("{time:.3}"));
+    }
+
+    pub fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// `dda3d run`.
+pub fn run(args: &RunArgs) -> Result<(), CliError> {
+    let scene = load_scene(&args.scene, &args.overrides)?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)));
+    let io = |e: std::io::Error| CliError::Run(format!("{}: {e}", out.display()));
+    let mut writer = RunWriter::create(&out).map_err(io)?;
+    let name = scene.name.clone();
+    let (method, mode) = (scene.params.method, scene.params.mode);
+    let mut solver = Solver::new(scene.model, scene.params);
+    let start = Instant::now();
+    let mut progress = Progress::new(solver.params.duration, args.quiet);
+    writer.write(&solver.snapshot()).map_err(io)?;
+    let mut failure: Option<SolverError> = None;
+    while !solver.finished() {
+        if let Err(e) = solver.step() {
+            failure = Some(e);
+            break;
+        }
+        writer.write(&solver.snapshot()).map_err(io)?;
+        progress.update(solver.time);
+    }
+    progress.finish();
+    writer.flush().map_err(io)?;
+    let wall = start.elapsed().as_secs_f64();
+    let mut summary = Summary::new(
+        &name,
+        method.as_str(),
+        mode.as_str(),
+        solver.time,
+        wall,
+        &solver.totals,
+    );
+    if let Some(e) = &failure {
+        summary.status = "diverged".into();
+        summary.error = Some(e.to_string());
+    }
+    summary.write(&out).map_err(io)?;
+    if let Some(e) = failure {
+        return Err(CliError::Run(format!(
+            "{}: {e}; results up to t = {:.6} s are in {}",
+            args.scene.display(),
+            solver.time,
+            out.display()
+        )));
+    }
+    if !args.quiet {
+        eprintln!(
+            "{}: {} steps to t = {:.3} s in {:.2} s wall; max penetration {:.3e} m; results in {}",
+            name,
+            solver.totals.steps,
+            solver.time,
+            wall,
+            solver.totals.max_penetration,
+            out.display()
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,1057 @@
+//! The DDA-3a / DDA-3p time-stepping solver: assembly, the open–close iteration with the inner
+//! augmented-Lagrangian loop (paper Fig. 3), the adaptive penalty (P21), the convergence tests
+//! (P22)–(P24) and time-step control (reference §6.3, §8).
+
+use std::collections::HashMap;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+use nalgebra::{Matrix6, Vector6};
+
+use crate::contact::{
+    Candidate, ContactKey, ContactState, ContactTerms, DetectionParams, NormalKinematics, Shape,
+    add_friction, add_normal_force, add_normal_stiffness, add_shear_spring, broad_phase,
+    detect_pair, normal_kinematics, planar_hull_area,
+};
+use crate::geometry::{
+    MassProperties, Topology, Vec3, bounding_box, mass_properties, newell_normal,
+};
+use crate::linear::{BlockMatrix, SparseCholesky};
+use crate::mechanics::{
+    BlockStepInput, Mat3x12, Mat12, Material, StepMap, Vec12, block_terms, displacement_matrix,
+    elasticity_matrix, mass_matrix, rotate_stress,
+};
+use crate::params::{Method, Mode, SolverParams};
+use crate::snapshot::{BlockSnapshot, ContactSnapshot, Snapshot, StepStats};
+
+/// One deformable block and its state carried between steps.
+#[derive(Clone, Debug)]
+pub struct Block {
+    pub name: String,
+    pub material: Material,
+    /// Held at every vertex by springs of `fixed_spring_factor · E`.
+    pub fixed: bool,
+    pub vertices: Vec<Vec3>,
+    pub topo: Arc<Topology>,
+    /// Unit outward normals, refreshed with the vertices.
+    pub face_normals: Vec<Vec3>,
+    pub mp: MassProperties,
+    /// Constant mass; the density follows the volume so that mass is conserved (§1.3).
+    pub mass: f64,
+    pub density: f64,
+    pub mass_matrix: Mat12,
+    pub elasticity: Matrix6<f64>,
+    /// 12-vector of DOF rates carried between steps (§3.2).
+    pub velocity: Vec12,
+    /// Accumulated stress [σx, σy, σz, τyz, τzx, τxy], Pa.
+    pub stress: Vector6<f64>,
+    pub strain: Vector6<f64>,
+    /// Spring anchors of a fixed block: the initial vertex positions.
+    pub anchors: Vec<Vec3>,
+    /// Point loads: (material point, force N).
+    pub loads: Vec<(Vec3, Vec3)>,
+    pub initial_centroid: Vec3,
+    pub lo: Vec3,
+    pub hi: Vec3,
+}
+
+impl Block {
+    /// A block from its hull; `velocity` is the initial centroid velocity and `spin` the initial
+    /// angular velocity (rad/s).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        name: String,
+        material: Material,
+        fixed: bool,
+        vertices: Vec<Vec3>,
+        topo: Topology,
+        velocity: Vec3,
+        spin: Vec3,
+        loads: Vec<(Vec3, Vec3)>,
+    ) -> Self {
+        let mp = mass_properties(&vertices, &topo.faces);
+        let mut v = Vec12::zeros();
+        v.fixed_rows_mut::<3>(0).copy_from(&velocity);
+        v.fixed_rows_mut::<3>(3).copy_from(&spin);
+        let mut b = Block {
+            name,
+            material,
+            fixed,
+            anchors: if fixed { vertices.clone() } else { Vec::new() },
+            vertices,
+            topo: Arc::new(topo),
+            face_normals: Vec::new(),
+            mp,
+            mass: material.density * mp.volume,
+            density: material.density,
+            mass_matrix: Mat12::zeros(),
+            elasticity: elasticity_matrix(material.young_modulus, material.poisson_ratio),
+            velocity: v,
+            stress: Vector6::zeros(),
+            strain: Vector6::zeros(),
+            loads,
+            initial_centroid: mp.centroid,
+            lo: Vec3::zeros(),
+            hi: Vec3::zeros(),
+        };
+        b.refresh();
+        b
+    }
+
+    /// Recomputes everything derived from the vertex positions.
+    fn refresh(&mut self) {
+        self.face_normals = self
+            .topo
+            .faces
+            .iter()
+            .map(|f| newell_normal(&self.vertices, f).normalize())
+            .collect();
+        self.mp = mass_properties(&self.vertices, &self.topo.faces);
+        self.density = self.mass / self.mp.volume;
+        self.mass_matrix = mass_matrix(self.density, &self.mp);
+        let (lo, hi) = bounding_box(&self.vertices);
+        self.lo = lo;
+        self.hi = hi;
+    }
+
+    fn shape(&self) -> Shape<'_> {
+        Shape {
+            vertices: &self.vertices,
+            topo: &self.topo,
+            face_normals: &self.face_normals,
+            centroid: self.mp.centroid,
+            lo: self.lo,
+            hi: self.hi,
+            fixed: self.fixed,
+        }
+    }
+
+    /// ½ vᵀ M v.
+    pub fn kinetic_energy(&self) -> f64 {
+        0.5 * (self.velocity.transpose() * self.mass_matrix * self.velocity)[0]
+    }
+
+    /// Largest distance from the centroid to a vertex.
+    fn radius(&self) -> f64 {
+        self.vertices
+            .iter()
+            .map(|v| (v - self.mp.centroid).norm())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The blocks of a scene.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub blocks: Vec<Block>,
+}
+
+/// What a contact carries from one step to the next (reference §4.5).
+#[derive(Clone, Copy, Debug)]
+struct Record {
+    state: ContactState,
+    /// λ, N (ALM only).
+    lambda: f64,
+    /// p_n, N/m.
+    penalty: f64,
+    /// Last normal force λ + p_n d_n (ALM) or p_n d_n (penalty), N.
+    normal_force: f64,
+    shear_force: f64,
+    penetration: f64,
+    /// Reference point P_b of a locked contact, moved with block j.
+    reference: Vec3,
+    /// Sliding direction of a relative to b.
+    tau: Vec3,
+    normal: Vec3,
+    /// Closed since the start and never opened or slid: still has cohesion.
+    intact: bool,
+    /// Joint area attributed to the contact for cohesion, m².
+    cohesion_area: f64,
+}
+
+/// A contact inside a step: its frozen geometry and the working values of the iterations.
+struct Active {
+    cand: Candidate,
+    kin: NormalKinematics,
+    rec: Record,
+    /// Record at the start of the step, restored when an attempt is redone.
+    start: Record,
+    ta: Mat3x12,
+    pair: usize,
+    young: f64,
+    dn: f64,
+    force: f64,
+    dn_prev: Option<f64>,
+    /// N(Δ + Δu_ab) of a locked contact after the last solve.
+    shear: Vec3,
+    /// Δu_ab projected on the tangent plane after the last solve.
+    slip: Vec3,
+}
+
+impl Active {
+    fn tb(&self, blocks: &[Block]) -> Mat3x12 {
+        let j = &blocks[self.cand.key.j as usize];
+        let xb = match self.rec.state {
+            ContactState::Lock => self.rec.reference,
+            _ => self.cand.xb,
+        };
+        displacement_matrix(&(xb - j.mp.centroid))
+    }
+}
+
+/// A run that cannot go on.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum SolverError {
+    #[error("diverged at t = {time:.6} s: {reason}")]
+    Diverged { time: f64, reason: String },
+}
+
+/// Wall time spent in the phases of the solver.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Timings {
+    pub detection: f64,
+    pub assembly: f64,
+    pub factorization: f64,
+    pub solve: f64,
+    pub bookkeeping: f64,
+}
+
+/// Totals over a run, for `summary.json` and the benchmark.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct RunTotals {
+    pub steps: u64,
+    pub open_close_iterations: u64,
+    pub alm_iterations: u64,
+    pub time_step_cuts: u64,
+    pub factorizations: u64,
+    pub symbolic_analyses: u64,
+    pub max_penetration: f64,
+    /// Steps accepted at the Δt floor without open–close convergence.
+    pub unconverged_steps: u64,
+    /// ALM loops that hit the iteration cap.
+    pub alm_cap_hits: u64,
+    pub contacts_per_step: f64,
+    pub timings: Timings,
+}
+
+enum Retry {
+    OpenClose,
+    Displacement(f64),
+    Penetration(f64),
+    NotFinite,
+}
+
+/// Steps a [`Model`] through time.
+pub struct Solver {
+    pub params: SolverParams,
+    pub model: Model,
+    pub time: f64,
+    pub step: u64,
+    dt: f64,
+    /// Half the largest extent of the initial model (Shi's w0).
+    w0: f64,
+    records: HashMap<ContactKey, Record>,
+    chol: SparseCholesky,
+    contacts: Vec<ContactSnapshot>,
+    pub last: StepStats,
+    pub totals: RunTotals,
+    contact_sum: u64,
+}
+
+impl Solver {
+    pub fn new(model: Model, params: SolverParams) -> Self {
+        let all: Vec<Vec3> = model
+            .blocks
+            .iter()
+            .flat_map(|b| b.vertices.iter().copied())
+            .collect();
+        let (lo, hi) = bounding_box(&all);
+        let w0 = 0.5 * (hi - lo).max();
+        let mut s = Solver {
+            dt: params.max_time_step,
+            params,
+            model,
+            time: 0.0,
+            step: 0,
+            w0,
+            records: HashMap::new(),
+            chol: SparseCholesky::default(),
+            contacts: Vec::new(),
+            last: StepStats::default(),
+            totals: RunTotals::default(),
+            contact_sum: 0,
+        };
+        s.last = s.energy_stats(StepStats::default());
+        s
+    }
+
+    pub fn w0(&self) -> f64 {
+        self.w0
+    }
+
+    /// d_n,max = 2 δ w0 of (P22).
+    pub fn max_step_penetration(&self) -> f64 {
+        2.0 * self.params.max_displacement_ratio * self.w0
+    }
+
+    pub fn finished(&self) -> bool {
+        self.time >= self.params.duration - 1e-9 * self.params.max_time_step
+    }
+
+    fn detection_params(&self) -> DetectionParams {
+        DetectionParams::new(self.w0, self.params.max_displacement_ratio)
+    }
+
+    /// Advances one step, never past `duration`.
+    pub fn step(&mut self) -> Result<&StepStats, SolverError> {
+        self.step_until(self.params.duration)
+    }
+
+    /// Advances one step without passing `limit` (so that outputs land on requested times).
+    pub fn step_until(&mut self, limit: f64) -> Result<&StepStats, SolverError> {
+        let limit = limit.min(self.params.duration);
+        let t_detect = Instant::now();
+        if self.params.mode == Mode::Static {
+            for b in &mut self.model.blocks {
+                b.velocity = Vec12::zeros();
+            }
+        }
+        let mut active = self.activate();
+        let pairs: Vec<(usize, usize)> = {
+            let mut p: Vec<(usize, usize)> = active
+                .iter()
+                .map(|c| (c.cand.key.i as usize, c.cand.key.j as usize))
+                .collect();
+            p.sort_unstable();
+            p.dedup();
+            p
+        };
+        let mut kmat = BlockMatrix::new(self.model.blocks.len(), pairs);
+        for c in &mut active {
+            c.pair = kmat
+                .pair_index(c.cand.key.i as usize, c.cand.key.j as usize)
+                .expect("pattern holds every contact pair");
+        }
+        self.totals.timings.detection += t_detect.elapsed().as_secs_f64();
+
+        let dt_floor = self.params.max_time_step / 100.0;
+        let remaining = limit - self.time;
+        let base = self.dt.min(self.predict_dt());
+        let mut dt = base;
+        if remaining <= dt * (1.0 + 1e-9) {
+            dt = remaining;
+        } else if remaining < 2.0 * dt {
+            dt = remaining / 2.0; // avoid a sliver of a step before the target time
+        }
+        let mut cuts = 0u32;
+        let mut factorizations = 0u32;
+        let (d, oc, alm) = loop {
+            match self.attempt(&mut active, &mut kmat, dt, &mut factorizations) {
+                Ok((d, oc, alm)) => break (d, oc, alm),
+                Err(reason) => {
+                    let at_floor = dt <= dt_floor * (1.0 + 1e-9);
+                    if at_floor {
+                        match reason {
+                            Retry::OpenClose => {
+                                // Shi's code accepts the last state at the Δt floor; count it.
+                                self.totals.unconverged_steps += 1;
+                                let r = self.attempt_accept_any(
+                                    &mut active,
+                                    &mut kmat,
+                                    dt,
+                                    &mut factorizations,
+                                );
+                                break r;
+                            }
+                            Retry::NotFinite => {
+                                return Err(self.diverged("the solution is not finite"));
+                            }
+                            Retry::Penetration(p) => {
+                                return Err(self.diverged(&format!(
+                                    "penetration {p:.3e} m exceeds the contact window at the minimum time step"
+                                )));
+                            }
+                            Retry::Displacement(r) => {
+                                return Err(self.diverged(&format!(
+                                    "vertex displacement {r:.1} times the allowed δ·w0 at the minimum time step"
+                                )));
+                            }
+                        }
+                    }
+                    dt = match reason {
+                        Retry::Displacement(r) => dt / r.sqrt() * 0.95,
+                        _ => dt * 0.3,
+                    }
+                    .max(dt_floor);
+                    cuts += 1;
+                    for c in &mut active {
+                        c.rec = c.start;
+                    }
+                }
+            }
+        };
+        let t_book = Instant::now();
+        self.commit(&d, dt, &active);
+        self.totals.timings.bookkeeping += t_book.elapsed().as_secs_f64();
+
+        let stats = StepStats {
+            time_step: dt,
+            open_close_iterations: oc,
+            alm_iterations: alm,
+            time_step_cuts: cuts,
+            factorizations,
+            max_penetration: self
+                .contacts
+                .iter()
+                .map(|c| c.penetration)
+                .fold(0.0, f64::max),
+            contacts_lock: self
+                .contacts
+                .iter()
+                .filter(|c| c.state == ContactState::Lock)
+                .count() as u32,
+            contacts_slide: self
+                .contacts
+                .iter()
+                .filter(|c| c.state == ContactState::Slide)
+                .count() as u32,
+            contacts_open: (active.len() - self.contacts.len()) as u32,
+            ..Default::default()
+        };
+        self.totals.steps += 1;
+        self.totals.open_close_iterations += oc as u64;
+        self.totals.alm_iterations += alm as u64;
+        self.totals.time_step_cuts += cuts as u64;
+        self.totals.factorizations += factorizations as u64;
+        self.totals.symbolic_analyses = self.chol.symbolic_count;
+        self.totals.max_penetration = self.totals.max_penetration.max(stats.max_penetration);
+        self.contact_sum += active.len() as u64;
+        self.totals.contacts_per_step = self.contact_sum as f64 / self.totals.steps as f64;
+        self.last = self.energy_stats(stats);
+        // The step grows back by at most 1.3× a step (Shi); a step shortened only to land on
+        // `limit` does not hold the next one back.
+        let grown_from = if cuts > 0 { dt } else { base };
+        self.dt = (grown_from * 1.3).min(self.params.max_time_step);
+        Ok(&self.last)
+    }
+
+    fn diverged(&self, reason: &str) -> SolverError {
+        SolverError::Diverged {
+            time: self.time,
+            reason: reason.to_string(),
+        }
+    }
+
+    fn energy_stats(&self, mut s: StepStats) -> StepStats {
+        let g = Vec3::from(self.params.gravity);
+        s.kinetic_energy = self
+            .model
+            .blocks
+            .iter()
+            .filter(|b| !b.fixed)
+            .map(Block::kinetic_energy)
+            .sum();
+        s.potential_energy = self
+            .model
+            .blocks
+            .iter()
+            .filter(|b| !b.fixed)
+            .map(|b| -b.mass * g.dot(&b.mp.centroid))
+            .sum();
+        s
+    }
+
+    /// Δt such that the fastest vertex moves at most δ·w0 under its current velocity and gravity
+    /// (Shi's prediction from ½ a Δt² + v Δt = δ w0).
+    fn predict_dt(&self) -> f64 {
+        let allowed = self.params.max_displacement_ratio * self.w0 * 0.9;
+        let a = Vec3::from(self.params.gravity).norm().max(1e-12);
+        let mut dt = self.params.max_time_step;
+        if self.params.mode == Mode::Static {
+            return dt;
+        }
+        for b in self.model.blocks.iter().filter(|b| !b.fixed) {
+            let v = &b.velocity;
+            let r = b.radius();
+            let speed = Vec3::new(v[0], v[1], v[2]).norm()
+                + Vec3::new(v[3], v[4], v[5]).norm() * r
+                + v.fixed_rows::<6>(6).norm() * r;
+            let t = (-speed + (speed * speed + 2.0 * a * allowed).sqrt()) / a;
+            dt = dt.min(t);
+        }
+        dt.max(self.params.max_time_step / 100.0)
+    }
+
+    /// Detects this step's contacts and attaches each to its record from the last step, or to a
+    /// new one (reference §4.5).
+    fn activate(&mut self) -> Vec<Active> {
+        let dp = self.detection_params();
+        let blocks = &self.model.blocks;
+        let shapes: Vec<Shape> = blocks.iter().map(Block::shape).collect();
+        let pairs = broad_phase(&shapes, dp.search_distance);
+        let records = &self.records;
+        let known = |k: &ContactKey| records.contains_key(k);
+        let mut cands: Vec<Candidate> = Vec::new();
+        for (a, b) in pairs {
+            cands.extend(detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known));
+        }
+        // Contact transfer: a vertex that slid onto an adjacent, almost coplanar face of the same
+        // block keeps its history.
+        let mut by_vertex: HashMap<(u32, u32, u32), ContactKey> = HashMap::new();
+        for k in self.records.keys() {
+            if k.mode == 0 {
+                by_vertex.insert((k.i, k.j, k.feature_i), *k);
+            }
+        }
+        let p = &self.params;
+        let first_step = self.step == 0;
+        let close_tol = p.contact.close_threshold * self.w0;
+        let mut active: Vec<Active> = cands
+            .into_iter()
+            .map(|cand| {
+                let (bi, bj) = (&blocks[cand.key.i as usize], &blocks[cand.key.j as usize]);
+                let kin = normal_kinematics(
+                    cand.mode(),
+                    &cand.points,
+                    &cand.normal,
+                    &bi.mp.centroid,
+                    &bj.mp.centroid,
+                );
+                let old = self.records.get(&cand.key).copied().or_else(|| {
+                    if cand.key.mode != 0 {
+                        return None;
+                    }
+                    let k = by_vertex.get(&(cand.key.i, cand.key.j, cand.key.feature_i))?;
+                    let r = self.records.get(k)?;
+                    (r.normal.dot(&cand.normal) > 3f64.to_radians().cos()).then_some(*r)
+                });
+                let mut rec = match old {
+                    Some(mut r) => {
+                        if !p.contact.warm_start || p.method == Method::Penalty {
+                            r.lambda = 0.0;
+                            r.penalty = p.contact.initial_penalty;
+                        }
+                        r.normal = cand.normal;
+                        r
+                    }
+                    None => {
+                        // A new contact touching or overlapping at the start is closed (locked);
+                        // one across a gap starts open.
+                        let touching = -cand.gap > -close_tol;
+                        Record {
+                            state: if touching {
+                                ContactState::Lock
+                            } else {
+                                ContactState::Open
+                            },
+                            lambda: 0.0,
+                            penalty: p.contact.initial_penalty,
+                            normal_force: 0.0,
+                            shear_force: 0.0,
+                            penetration: -cand.gap,
+                            reference: cand.xb,
+                            tau: Vec3::zeros(),
+                            normal: cand.normal,
+                            intact: first_step && touching,
+                            cohesion_area: 0.0,
+                        }
+                    }
+                };
+                if p.method == Method::Penalty {
+                    rec.penalty = p.contact.initial_penalty;
+                }
+                let ta = displacement_matrix(&(cand.xa - bi.mp.centroid));
+                Active {
+                    kin,
+                    ta,
+                    young: bi.material.young_modulus.min(bj.material.young_modulus),
+                    start: rec,
+                    rec,
+                    cand,
+                    pair: 0,
+                    dn: 0.0,
+                    force: 0.0,
+                    dn_prev: None,
+                    shear: Vec3::zeros(),
+                    slip: Vec3::zeros(),
+                }
+            })
+            .collect();
+        if first_step && p.joint.cohesion > 0.0 {
+            assign_cohesion_areas(&mut active);
+        }
+        active
+    }
+
+    /// One attempt at the step with length `dt`: the open–close loop around the ALM loop.
+    fn attempt(
+        &mut self,
+        active: &mut [Active],
+        kmat: &mut BlockMatrix,
+        dt: f64,
+        factorizations: &mut u32,
+    ) -> Result<(Vec<f64>, u32, u32), Retry> {
+        self.iterate(active, kmat, dt, factorizations, false)
+    }
+
+    /// The last resort at the Δt floor: accept the state of the final open–close pass.
+    fn attempt_accept_any(
+        &mut self,
+        active: &mut [Active],
+        kmat: &mut BlockMatrix,
+        dt: f64,
+        factorizations: &mut u32,
+    ) -> (Vec<f64>, u32, u32) {
+        for c in active.iter_mut() {
+            c.rec = c.start;
+        }
+        match self.iterate(active, kmat, dt, factorizations, true) {
+            Ok(r) => r,
+            Err(_) => unreachable!("accept_any never retries"),
+        }
+    }
+
+    fn iterate(
+        &mut self,
+        active: &mut [Active],
+        kmat: &mut BlockMatrix,
+        dt: f64,
+        factorizations: &mut u32,
+        accept_any: bool,
+    ) -> Result<(Vec<f64>, u32, u32), Retry> {
+        let p = self.params.clone();
+        let cp = &p.contact;
+        let nb = self.model.blocks.len();
+        let t_asm = Instant::now();
+        let g = Vec3::from(p.gravity);
+        // (K0, F0): the block terms of §3, fixed for the attempt.
+        let mut k0: Vec<Mat12> = Vec::with_capacity(nb);
+        let mut f0: Vec<Vec12> = Vec::with_capacity(nb);
+        for b in &self.model.blocks {
+            let springs: Vec<(Vec3, Vec3, f64)> = if b.fixed {
+                let k = p.fixed_spring_factor * b.material.young_modulus;
+                b.vertices
+                    .iter()
+                    .zip(&b.anchors)
+                    .map(|(x, a)| (*x, *a, k))
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            let loads: Vec<(Vec3, Vec3)> = b.loads.clone();
+            let terms = block_terms(
+                &BlockStepInput {
+                    mass_matrix: &b.mass_matrix,
+                    mp: &b.mp,
+                    density: b.density,
+                    elasticity: &b.elasticity,
+                    stress: &b.stress,
+                    velocity: &b.velocity,
+                    gravity: &g,
+                    loads: &loads,
+                    springs: &springs,
+                },
+                dt,
+            );
+            k0.push(terms.k);
+            f0.push(terms.f);
+        }
+        let mut timings = Duration::ZERO;
+        timings += t_asm.elapsed();
+
+        let tan_phi = p.joint.friction_angle.to_radians().tan();
+        let dn_max = self.max_step_penetration();
+        let close_tol = cp.close_threshold * self.w0;
+        let mut d = vec![0.0; 12 * nb];
+        let mut oc_passes = 0u32;
+        let mut solves = 0u32;
+        let mut converged_states = false;
+        for _oc in 0..cp.max_open_close_iterations {
+            oc_passes += 1;
+            let mut k_dirty = true;
+            for c in active.iter_mut() {
+                c.dn_prev = None;
+            }
+            let mut alm_converged = false;
+            for _ in 0..cp.max_alm_iterations {
+                let t0 = Instant::now();
+                if k_dirty {
+                    for (i, kd) in kmat.diag.iter_mut().enumerate() {
+                        *kd = k0[i];
+                    }
+                    for o in kmat.off.iter_mut() {
+                        *o = Mat12::zeros();
+                    }
+                }
+                let mut f: Vec<f64> = f0.iter().flat_map(|v| v.iter().copied()).collect();
+                for c in active.iter() {
+                    if c.rec.state == ContactState::Open {
+                        continue;
+                    }
+                    let mut t = ContactTerms::zero();
+                    if k_dirty {
+                        add_normal_stiffness(&mut t, &c.kin, c.rec.penalty);
+                    }
+                    let lambda = if p.method == Method::Alm {
+                        c.rec.lambda
+                    } else {
+                        0.0
+                    };
+                    add_normal_force(&mut t, &c.kin, c.rec.penalty, lambda);
+                    let tb = c.tb(&self.model.blocks);
+                    match c.rec.state {
+                        ContactState::Lock => {
+                            let delta = c.cand.xa - c.rec.reference;
+                            add_shear_spring(
+                                &mut t,
+                                &c.ta,
+                                &tb,
+                                &c.cand.normal,
+                                &delta,
+                                cp.shear_penalty_ratio * c.rec.penalty,
+                                k_dirty,
+                            );
+                        }
+                        ContactState::Slide => {
+                            let n_prev = if p.method == Method::Alm {
+                                c.rec.lambda
+                            } else {
+                                c.rec.normal_force.max(0.0)
+                            };
+                            add_friction(&mut t, &c.ta, &tb, &c.rec.tau, n_prev * tan_phi);
+                        }
+                        ContactState::Open => unreachable!(),
+                    }
+                    let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
+                    if k_dirty {
+                        kmat.diag[i] += t.k_ii;
+                        kmat.diag[j] += t.k_jj;
+                        kmat.add_off(c.pair, i, j, &t.k_ij);
+                    }
+                    for a in 0..12 {
+                        f[12 * i + a] += t.f_i[a];
+                        f[12 * j + a] += t.f_j[a];
+                    }
+                }
+                timings += t0.elapsed();
+                if k_dirty {
+                    let tf = Instant::now();
+                    let ok = self.chol.factorize(kmat);
+                    self.totals.timings.factorization += tf.elapsed().as_secs_f64();
+                    *factorizations += 1;
+                    if ok.is_err() {
+                        self.totals.timings.assembly += timings.as_secs_f64();
+                        return Err(Retry::NotFinite);
+                    }
+                    k_dirty = false;
+                }
+                let ts = Instant::now();
+                self.chol.solve_in_place(&mut f);
+                self.totals.timings.solve += ts.elapsed().as_secs_f64();
+                solves += 1;
+                d = f;
+                if d.iter().any(|x| !x.is_finite()) {
+                    self.totals.timings.assembly += timings.as_secs_f64();
+                    return Err(Retry::NotFinite);
+                }
+                let t1 = Instant::now();
+                // d_n and N of every closed contact (5.4), (5.6).
+                let mut max_dn: f64 = 0.0;
+                let (mut dl2, mut l2) = (0.0, 0.0);
+                for c in active.iter_mut() {
+                    let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
+                    let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+                    let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
+                    c.dn = c.kin.d0 + c.kin.g_i.dot(&di) + c.kin.g_j.dot(&dj);
+                    if c.rec.state == ContactState::Open {
+                        continue;
+                    }
+                    let lambda = if p.method == Method::Alm {
+                        c.rec.lambda
+                    } else {
+                        0.0
+                    };
+                    c.force = lambda + c.rec.penalty * c.dn;
+                    max_dn = max_dn.max(c.dn.abs());
+                    if p.method == Method::Alm {
+                        let new = c.force.max(0.0);
+                        dl2 += (new - c.rec.lambda).powi(2);
+                        l2 += c.rec.lambda.powi(2);
+                    }
+                }
+                if p.method == Method::Penalty {
+                    timings += t1.elapsed();
+                    alm_converged = true;
+                    break;
+                }
+                // (P23) and (P24); an unchanged zero force vector counts as converged.
+                let conv1 = max_dn <= cp.eps1 * dn_max;
+                let conv2 = dl2 == 0.0 || dl2.sqrt() < cp.eps2 * l2.sqrt();
+                for c in active.iter_mut() {
+                    if c.rec.state == ContactState::Open {
+                        continue;
+                    }
+                    // (P1): λ_k = λ_{k−1} + p_n d_n, kept non-negative.
+                    c.rec.lambda = c.force.max(0.0);
+                    // (P21): raise the penalty where the penetration does not fall fast enough.
+                    if let Some(prev) = c.dn_prev
+                        && !(conv1 && conv2)
+                        && c.dn.abs() > cp.beta * prev.abs()
+                    {
+                        let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
+                        if capped > c.rec.penalty {
+                            c.rec.penalty = capped;
+                            k_dirty = true;
+                        }
+                    }
+                    c.dn_prev = Some(c.dn);
+                }
+                timings += t1.elapsed();
+                if conv1 && conv2 {
+                    alm_converged = true;
+                    break;
+                }
+            }
+            if !alm_converged {
+                self.totals.alm_cap_hits += 1;
+            }
+            // Open–close check (reference §6.1).
+            let t2 = Instant::now();
+            let mut changed = false;
+            for c in active.iter_mut() {
+                let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
+                let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+                let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
+                let tb = c.tb(&self.model.blocks);
+                let n = c.cand.normal;
+                let du = c.ta * di - tb * dj;
+                c.slip = du - n * n.dot(&du);
+                match c.rec.state {
+                    ContactState::Open => {
+                        if c.dn > close_tol {
+                            c.rec.state = ContactState::Lock;
+                            c.rec.reference = c.cand.xb;
+                            c.rec.lambda = 0.0;
+                            c.rec.penalty = cp.initial_penalty;
+                            c.rec.normal_force = 0.0;
+                            changed = true;
+                        }
+                    }
+                    ContactState::Lock | ContactState::Slide => {
+                        c.rec.normal_force = c.force;
+                        if c.force < 0.0 {
+                            c.rec.state = ContactState::Open;
+                            c.rec.lambda = 0.0;
+                            c.rec.intact = false;
+                            changed = true;
+                            continue;
+                        }
+                        if c.rec.state == ContactState::Lock {
+                            let delta = c.cand.xa - c.rec.reference;
+                            let r = delta + du;
+                            c.shear = r - n * n.dot(&r);
+                            let shear = cp.shear_penalty_ratio * c.rec.penalty * c.shear.norm();
+                            let cohesion = if c.rec.intact {
+                                p.joint.cohesion * c.rec.cohesion_area
+                            } else {
+                                0.0
+                            };
+                            if shear > c.force * tan_phi + cohesion {
+                                c.rec.state = ContactState::Slide;
+                                c.rec.tau = c.shear.normalize();
+                                c.rec.intact = false;
+                                changed = true;
+                            }
+                        } else if c.slip.dot(&c.rec.tau) < 0.0 {
+                            c.rec.state = ContactState::Lock;
+                            c.rec.reference = c.cand.xb;
+                            changed = true;
+                        } else if c.slip.norm() > 1e-9 * self.w0 {
+                            c.rec.tau = c.slip.normalize();
+                        }
+                    }
+                }
+            }
+            timings += t2.elapsed();
+            if !changed {
+                converged_states = true;
+                break;
+            }
+        }
+        self.totals.timings.assembly += timings.as_secs_f64();
+        if !converged_states && !accept_any {
+            return Err(Retry::OpenClose);
+        }
+        // Step size checks on the converged solution.
+        let allowed = p.max_displacement_ratio * self.w0;
+        let mut max_u: f64 = 0.0;
+        for (i, b) in self.model.blocks.iter().enumerate() {
+            let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+            for v in &b.vertices {
+                max_u = max_u.max((displacement_matrix(&(v - b.mp.centroid)) * di).norm());
+            }
+        }
+        if !accept_any {
+            let r = max_u / allowed;
+            if r > p.max_displacement_overshoot {
+                return Err(Retry::Displacement(r));
+            }
+            let dpen = self.detection_params().max_penetration;
+            let worst = active
+                .iter()
+                .filter(|c| c.rec.state.is_closed())
+                .map(|c| c.dn)
+                .fold(0.0, f64::max);
+            if worst > dpen {
+                return Err(Retry::Penetration(worst));
+            }
+        }
+        Ok((d, oc_passes, solves))
+    }
+
+    /// Accepts the step: velocities, stresses, the finite-rotation vertex update (1.3), and the
+    /// contact records for the next step.
+    fn commit(&mut self, d: &[f64], dt: f64, active: &[Active]) {
+        let p = &self.params;
+        let tan_phi = p.joint.friction_angle.to_radians().tan();
+        // Contact outputs use the start-of-step geometry moved by the step.
+        let mut maps = Vec::with_capacity(self.model.blocks.len());
+        for (i, b) in self.model.blocks.iter().enumerate() {
+            let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+            maps.push(StepMap::new(b.mp.centroid, &di));
+        }
+        self.contacts.clear();
+        let mut records = HashMap::with_capacity(active.len());
+        for c in active {
+            let mut rec = c.rec;
+            let closed = rec.state.is_closed();
+            rec.penetration = c.dn;
+            if closed {
+                rec.normal_force = c.force;
+                rec.shear_force = match rec.state {
+                    ContactState::Lock => {
+                        p.contact.shear_penalty_ratio * rec.penalty * c.shear.norm()
+                    }
+                    _ => {
+                        let n_prev = if p.method == Method::Alm {
+                            rec.lambda
+                        } else {
+                            rec.normal_force.max(0.0)
+                        };
+                        n_prev * tan_phi
+                    }
+                };
+            } else {
+                rec.normal_force = 0.0;
+                rec.shear_force = 0.0;
+            }
+            let mj = &maps[c.cand.key.j as usize];
+            rec.reference = mj.apply(&rec.reference);
+            rec.tau = mj.rotation() * rec.tau;
+            if closed {
+                let point = mj.apply(&c.cand.xb);
+                self.contacts.push(ContactSnapshot {
+                    block_i: c.cand.key.i as usize,
+                    block_j: c.cand.key.j as usize,
+                    mode: c.cand.mode(),
+                    state: rec.state,
+                    point: point.into(),
+                    normal: (mj.rotation() * c.cand.normal).into(),
+                    normal_force: rec.normal_force,
+                    shear_force: rec.shear_force,
+                    penetration: c.dn,
+                    penalty: rec.penalty,
+                    lambda: if p.method == Method::Alm {
+                        rec.lambda
+                    } else {
+                        0.0
+                    },
+                });
+            }
+            records.insert(c.cand.key, rec);
+        }
+        self.records = records;
+
+        for (i, b) in self.model.blocks.iter_mut().enumerate() {
+            let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+            // (3.2): v1 = 2D/Δt − v0.
+            b.velocity = di * (2.0 / dt) - b.velocity;
+            let de = di.fixed_rows::<6>(6).into_owned();
+            let map = &maps[i];
+            if p.rotate_stress {
+                b.stress = rotate_stress(&b.stress, map.rotation());
+            }
+            b.stress += b.elasticity * de;
+            b.strain += de;
+            for v in &mut b.vertices {
+                *v = map.apply(v);
+            }
+            for (pt, force) in &mut b.loads {
+                *pt = map.apply(pt);
+                *force = map.rotation() * *force;
+            }
+            b.refresh();
+        }
+        self.time += dt;
+        self.step += 1;
+    }
+
+    /// The state now, as plain data.
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            scene_name: self.model.name.clone(),
+            time: self.time,
+            step: self.step,
+            blocks: self
+                .model
+                .blocks
+                .iter()
+                .map(|b| BlockSnapshot {
+                    name: b.name.clone(),
+                    fixed: b.fixed,
+                    vertices: b.vertices.iter().map(|v| (*v).into()).collect(),
+                    faces: b
+                        .topo
+                        .faces
+                        .iter()
+                        .map(|f| f.iter().map(|&k| k as u32).collect())
+                        .collect(),
+                    centroid: b.mp.centroid.into(),
+                    velocity: [b.velocity[0], b.velocity[1], b.velocity[2]],
+                    displacement: (b.mp.centroid - b.initial_centroid).into(),
+                })
+                .collect(),
+            contacts: self.contacts.clone(),
+            stats: self.last.clone(),
+        }
+    }
+
+    /// Closed contacts after the last step.
+    pub fn contacts(&self) -> &[ContactSnapshot] {
+        &self.contacts
+    }
+}
+
+/// Shares each joint's contact area among its contact points (for cohesion, which acts only on
+/// intact contacts of the initial state).
+fn assign_cohesion_areas(active: &mut [Active]) {
+    let mut groups: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (k, c) in active.iter().enumerate() {
+        if c.rec.intact {
+            let key = (
+                c.cand.key.i.min(c.cand.key.j),
+                c.cand.key.i.max(c.cand.key.j),
+            );
+            groups.entry(key).or_default().push(k);
+        }
+    }
+    for idx in groups.values() {
+        let pts: Vec<Vec3> = idx.iter().map(|&k| active[k].cand.xb).collect();
+        let area = planar_hull_area(&pts, &active[idx[0]].cand.normal);
+        for &k in idx {
+            active[k].rec.cohesion_area = area / idx.len() as f64;
+            active[k].start.cohesion_area = area / idx.len() as f64;
+        }
+    }
+}
