@@ -129,12 +129,12 @@ impl SparseCholesky {
         let mut col_ptr = Vec::with_capacity(n + 1);
         let mut row_idx = Vec::new();
         col_ptr.push(0);
-        for j in 0..nb {
+        for (j, rows) in rows_of.iter().enumerate() {
             for c in 0..12 {
                 for r in c..12 {
                     row_idx.push(12 * j + r);
                 }
-                for &i in &rows_of[j] {
+                for &i in rows {
                     for r in 0..12 {
                         row_idx.push(12 * i + r);
                     }

@@ -217,8 +217,8 @@ mod tests {
                 let vol = (p[1] - p[0]).dot(&(p[2] - p[0]).cross(&(p[3] - p[0]))) / 6.0;
                 for q in 0..4 {
                     let mut x = Vec3::zeros();
-                    for r in 0..4 {
-                        x += p[r] * if r == q { a } else { b };
+                    for (r, pr) in p.iter().enumerate() {
+                        x += pr * if r == q { a } else { b };
                     }
                     sum += f(&x) * (vol / 4.0);
                 }

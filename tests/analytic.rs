@@ -1,6 +1,6 @@
 //! Closed-form checks of the integrator and the kinematics (reference §9(d)).
 
-use dda3d::geometry::{box_vertices, convex_hull, mass_properties, rotation_xyz_degrees, Vec3};
+use dda3d::geometry::{Vec3, box_vertices, convex_hull, mass_properties, rotation_xyz_degrees};
 use dda3d::mechanics::Material;
 use dda3d::params::{Mode, SolverParams};
 use dda3d::solver::{Block, Model, Solver};
@@ -12,7 +12,11 @@ const ROCK: Material = Material {
 };
 
 fn single(center: [f64; 3], velocity: Vec3, spin: Vec3, params: SolverParams) -> Solver {
-    let pts = box_vertices([1.0, 2.0, 0.5], center, &rotation_xyz_degrees([10.0, 20.0, 30.0]));
+    let pts = box_vertices(
+        [1.0, 2.0, 0.5],
+        center,
+        &rotation_xyz_degrees([10.0, 20.0, 30.0]),
+    );
     let (v, t) = convex_hull(&pts).unwrap();
     let b = Block::new("b".into(), ROCK, false, v, t, velocity, spin, vec![]);
     Solver::new(
@@ -40,10 +44,18 @@ fn projectile_is_exact() {
     }
     let x = Vec3::from(s.snapshot().blocks[0].centroid);
     let want = x0 + v0 * 2.0 + Vec3::new(0.0, 0.0, -9.8) * 2.0;
-    assert!((x - want).norm() < 1e-9, "error {:e} m after {} steps", (x - want).norm(), s.step);
+    assert!(
+        (x - want).norm() < 1e-9,
+        "error {:e} m after {} steps",
+        (x - want).norm(),
+        s.step
+    );
     let v = Vec3::from(s.snapshot().blocks[0].velocity);
     assert!((v - Vec3::new(3.0, 0.0, 10.0 - 19.6)).norm() < 1e-9);
-    assert!(s.step > 200, "the displacement limit δ·w0 must have shortened the steps");
+    assert!(
+        s.step > 200,
+        "the displacement limit δ·w0 must have shortened the steps"
+    );
 }
 
 /// Static mode resets the velocity each step: a free block creeps by ½ g Δt² per step instead of
@@ -61,7 +73,10 @@ fn static_mode_discards_velocity() {
         s.step().unwrap();
     }
     let drop = z0 - s.snapshot().blocks[0].centroid[2];
-    assert!((drop - 10.0 * 0.5 * 9.8 * 0.01f64.powi(2)).abs() < 1e-12, "{drop}");
+    assert!(
+        (drop - 10.0 * 0.5 * 9.8 * 0.01f64.powi(2)).abs() < 1e-12,
+        "{drop}"
+    );
 }
 
 /// A block spinning freely (no gravity) keeps its volume with the Rodrigues update (1.3) and
@@ -91,7 +106,10 @@ fn free_rotation_keeps_volume_and_energy() {
     assert!((v1 / v0 - 1.0).abs() < 1e-9, "volume ratio {}", v1 / v0);
     let e1 = s.last.kinetic_energy;
     assert!(e1 <= e0 * (1.0 + 1e-9), "energy grew from {e0} to {e1}");
-    assert!(e1 > 0.9 * e0, "free rotation is nearly conservative: {e0} → {e1}");
+    assert!(
+        e1 > 0.9 * e0,
+        "free rotation is nearly conservative: {e0} → {e1}"
+    );
     // 2 rad/s about the vertical for 1 s turns a vertex about the z axis through 2 rad.
     let turned = (angle(&s) - a0).rem_euclid(std::f64::consts::TAU);
     assert!((turned - 2.0).abs() < 0.02, "turned {turned} rad");

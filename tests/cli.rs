@@ -23,7 +23,13 @@ fn tmp(name: &str) -> PathBuf {
 fn run_writes_the_three_outputs() {
     let out = tmp("run");
     let st = bin()
-        .args(["run", scenes().join("slope_sliding.toml").to_str().unwrap(), "--duration", "0.2", "--out"])
+        .args([
+            "run",
+            scenes().join("slope_sliding.toml").to_str().unwrap(),
+            "--duration",
+            "0.2",
+            "--out",
+        ])
         .arg(&out)
         .status()
         .unwrap();
@@ -33,20 +39,35 @@ fn run_writes_the_three_outputs() {
     assert_eq!(lines.next(), Some("time,block,x,y,z,vx,vy,vz"));
     let rows: Vec<&str> = lines.collect();
     // Two blocks, time 0 included, one row per block per step.
-    assert!(rows.len() >= 2 * 21 && rows.len() % 2 == 0, "{} rows", rows.len());
+    assert!(
+        rows.len() >= 2 * 21 && rows.len().is_multiple_of(2),
+        "{} rows",
+        rows.len()
+    );
     assert!(rows[0].starts_with("0,slope,") && rows[1].starts_with("0,block,"));
     let contacts = std::fs::read_to_string(out.join("contacts.csv")).unwrap();
     let mut lines = contacts.lines();
     assert_eq!(
         lines.next(),
-        Some("time,block_i,block_j,mode,state,px,py,pz,nx,ny,nz,normal_force,shear_force,penetration,penalty,lambda")
+        Some(
+            "time,block_i,block_j,mode,state,px,py,pz,nx,ny,nz,normal_force,shear_force,penetration,penalty,lambda"
+        )
     );
     let last: Vec<&str> = lines.last().unwrap().split(',').collect();
     assert_eq!(&last[1..5], &["block", "slope", "vertex-face", "slide"]);
     let n: f64 = last[11].parse().unwrap();
     assert!(n > 1e4, "compressive normal force is positive: {n}");
-    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    for key in ["steps", "simulated_time", "wall_seconds", "max_penetration", "open_close_iterations", "alm_iterations", "time_step_cuts"] {
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "steps",
+        "simulated_time",
+        "wall_seconds",
+        "max_penetration",
+        "open_close_iterations",
+        "alm_iterations",
+        "time_step_cuts",
+    ] {
         assert!(summary.get(key).is_some(), "summary.json lacks {key}");
     }
     assert!((summary["simulated_time"].as_f64().unwrap() - 0.2).abs() < 1e-12);
@@ -56,7 +77,13 @@ fn expect_input_error(text: &str, needle: &str) {
     let dir = tmp("bad");
     let path = dir.join("bad.toml");
     std::fs::write(&path, text).unwrap();
-    let out = bin().arg("run").arg(&path).arg("--out").arg(dir.join("o")).output().unwrap();
+    let out = bin()
+        .arg("run")
+        .arg(&path)
+        .arg("--out")
+        .arg(dir.join("o"))
+        .output()
+        .unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "stderr: {err}");
     assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
@@ -80,22 +107,42 @@ box = { size = [1, 1, 1], center = [0, 0, 0.5] }
 fn bad_input_is_one_line_and_exit_status_2() {
     expect_input_error("name = \"x\"\n[solver\nmethod = \"alm\"", "line 2");
     expect_input_error(&format!("{GOOD}colour = \"red\"\n"), "colour");
-    expect_input_error(&GOOD.replace("material = \"rock\"", "material = \"basalt\""), "basalt");
-    expect_input_error(&GOOD.replace("box = { size = [1, 1, 1], center = [0, 0, 0.5] }", "vertices = [[0,0,0],[1,0,0],[0,1,0]]"), "four");
+    expect_input_error(
+        &GOOD.replace("material = \"rock\"", "material = \"basalt\""),
+        "basalt",
+    );
+    expect_input_error(
+        &GOOD.replace(
+            "box = { size = [1, 1, 1], center = [0, 0, 0.5] }",
+            "vertices = [[0,0,0],[1,0,0],[0,1,0]]",
+        ),
+        "four",
+    );
     expect_input_error(&GOOD.replace("2750.0", "0.0"), "density");
     expect_input_error(&GOOD.replace("2.0e10", "-2.0e10"), "young_modulus");
     expect_input_error(&GOOD.replace("0.25", "0.7"), "poisson_ratio");
     expect_input_error(&GOOD.replace("2750.0", "nan"), "finite");
-    expect_input_error(&format!("{GOOD}[[blocks]]\nname = \"b\"\nmaterial = \"rock\"\nbox = {{ size = [1, 1, 1], center = [0.5, 0, 0.5] }}\n"), "overlap");
+    expect_input_error(
+        &format!(
+            "{GOOD}[[blocks]]\nname = \"b\"\nmaterial = \"rock\"\nbox = {{ size = [1, 1, 1], center = [0.5, 0, 0.5] }}\n"
+        ),
+        "overlap",
+    );
     expect_input_error("[solver]\nmethod = \"lagrange\"\n", "lagrange");
 }
 
 #[test]
 fn missing_file_and_bad_flags_exit_2() {
-    let out = bin().args(["run", "/nonexistent/scene.toml"]).output().unwrap();
+    let out = bin()
+        .args(["run", "/nonexistent/scene.toml"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/scene.toml"));
-    let out = bin().args(["run", "x.toml", "--method", "magic"]).output().unwrap();
+    let out = bin()
+        .args(["run", "x.toml", "--method", "magic"])
+        .output()
+        .unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
 

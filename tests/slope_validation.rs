@@ -20,7 +20,12 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 fn solver(file: &str, method: Method) -> Solver {
-    let mut s = scene::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes").join(file)).expect("scene loads");
+    let mut s = scene::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join(file),
+    )
+    .expect("scene loads");
     s.params.method = method;
     Solver::new(s.model, s.params)
 }
@@ -43,8 +48,18 @@ fn run_table1(method: Method) -> Table1 {
         .contacts
         .iter()
         .map(|c| {
-            assert_eq!(c.state, ContactState::Lock, "φ = 35° > 30°: every contact holds");
-            (dot(c.point, downslope()), c.normal_force, c.penetration, c.penalty, c.lambda)
+            assert_eq!(
+                c.state,
+                ContactState::Lock,
+                "φ = 35° > 30°: every contact holds"
+            );
+            (
+                dot(c.point, downslope()),
+                c.normal_force,
+                c.penetration,
+                c.penalty,
+                c.lambda,
+            )
         })
         .collect();
     let d = block.displacement;
@@ -66,35 +81,70 @@ fn table1_stable_block_contact_forces() {
 
     let mut worst = std::collections::HashMap::new();
     println!("\nTable 1 at t = 2.00 s (static mode)");
-    println!("{:8} {:10} {:>12} {:>12} {:>10} {:>12} {:>12}", "method", "contact", "theory N", "N", "error %", "d_n m", "p_n N/m");
+    println!(
+        "{:8} {:10} {:>12} {:>12} {:>10} {:>12} {:>12}",
+        "method", "contact", "theory N", "N", "error %", "d_n m", "p_n N/m"
+    );
     for method in [Method::Alm, Method::Penalty] {
         let t = run_table1(method);
-        assert_eq!(t.contacts.len(), 4, "{method:?}: the four base corners, no duplicates");
+        assert_eq!(
+            t.contacts.len(),
+            4,
+            "{method:?}: the four base corners, no duplicates"
+        );
         let mid = t.contacts.iter().map(|c| c.0).sum::<f64>() / 4.0;
         let mut err_max: f64 = 0.0;
         for &(pos, n, dn, pn, lambda) in &t.contacts {
-            let (label, theory) = if pos < mid { ("N1=N2", n_up) } else { ("N3=N4", n_down) };
+            let (label, theory) = if pos < mid {
+                ("N1=N2", n_up)
+            } else {
+                ("N3=N4", n_down)
+            };
             let err = (n - theory).abs() / theory;
             err_max = err_max.max(err);
-            println!("{:8} {:10} {:>12.1} {:>12.1} {:>10.4} {:>12.3e} {:>12.2e}  λ = {:.1}", format!("{method:?}"), label, theory, n, 100.0 * err, dn, pn, lambda);
+            println!(
+                "{:8} {:10} {:>12.1} {:>12.1} {:>10.4} {:>12.3e} {:>12.2e}  λ = {:.1}",
+                format!("{method:?}"),
+                label,
+                theory,
+                n,
+                100.0 * err,
+                dn,
+                pn,
+                lambda
+            );
             match method {
                 Method::Alm => {
-                    assert!(err <= 0.0004, "ALM {label}: error {:.5} % > 0.04 %", 100.0 * err);
+                    assert!(
+                        err <= 0.0004,
+                        "ALM {label}: error {:.5} % > 0.04 %",
+                        100.0 * err
+                    );
                     assert!(dn <= 1.3e-5, "ALM {label}: penetration {dn:e} m > 1.3e-5 m");
                 }
                 Method::Penalty => {
                     // DDA-3p: the force is carried by the penetration alone, N = p_n d_n, so the
                     // penetration is N / p_n = 1.66e-4 and 3.01e-4 m (paper: 1.648e-4, 3.0008e-4).
                     assert!((n - pn * dn).abs() < 1e-6 * n);
-                    assert!((dn - theory / 2.0e8).abs() < 0.01 * theory / 2.0e8, "{label}: {dn:e}");
+                    assert!(
+                        (dn - theory / 2.0e8).abs() < 0.01 * theory / 2.0e8,
+                        "{label}: {dn:e}"
+                    );
                 }
             }
         }
         assert!(t.drift < 1e-3, "{method:?}: the block crept {} m", t.drift);
         worst.insert(format!("{method:?}"), err_max);
     }
-    println!("largest force error: ALM {:.2e} %, penalty {:.2e} %", 100.0 * worst["Alm"], 100.0 * worst["Penalty"]);
-    assert!(worst["Penalty"] > worst["Alm"], "the penalty method is the less accurate one");
+    println!(
+        "largest force error: ALM {:.2e} %, penalty {:.2e} %",
+        100.0 * worst["Alm"],
+        100.0 * worst["Penalty"]
+    );
+    assert!(
+        worst["Penalty"] > worst["Alm"],
+        "the penalty method is the less accurate one"
+    );
 }
 
 #[test]
@@ -123,14 +173,27 @@ fn table2_sliding_block_displacement() {
         results.push(rows);
     }
     println!("\nTable 2: centroid travel along the slope (m) and relative error (%)");
-    println!("{:>5} {:>9} {:>9} {:>9} {:>8} {:>8} {:>10} {:>10}", "t s", "theory", "ALM", "penalty", "err ALM", "err pen", "paper 3a", "paper 3p");
+    println!(
+        "{:>5} {:>9} {:>9} {:>9} {:>8} {:>8} {:>10} {:>10}",
+        "t s", "theory", "ALM", "penalty", "err ALM", "err pen", "paper 3a", "paper 3p"
+    );
     for k in 0..10 {
         let t = 0.2 * (k + 1) as f64;
         let theory = acc * t * t;
         let (a, p) = (results[0][k], results[1][k]);
-        let (ea, ep) = (100.0 * (a - theory).abs() / theory, 100.0 * (p - theory).abs() / theory);
-        println!("{t:>5.1} {theory:>9.4} {a:>9.4} {p:>9.4} {ea:>8.3} {ep:>8.3} {:>10.2} {:>10.2}", paper_3a[k], paper_3p[k]);
-        assert!(ea <= paper_3a[k], "t = {t}: ALM error {ea:.3} % above the paper's {} %", paper_3a[k]);
+        let (ea, ep) = (
+            100.0 * (a - theory).abs() / theory,
+            100.0 * (p - theory).abs() / theory,
+        );
+        println!(
+            "{t:>5.1} {theory:>9.4} {a:>9.4} {p:>9.4} {ea:>8.3} {ep:>8.3} {:>10.2} {:>10.2}",
+            paper_3a[k], paper_3p[k]
+        );
+        assert!(
+            ea <= paper_3a[k],
+            "t = {t}: ALM error {ea:.3} % above the paper's {} %",
+            paper_3a[k]
+        );
         assert!(ea < ep, "t = {t}: ALM must beat the penalty baseline");
     }
 }
