@@ -404,7 +404,7 @@ vertices = [[-1,-1,2],[1,-1,2],[1,1,2],[-1,1,2],[-1,-1,4],[1,-1,4],[1,1,4],[-1,1
             "material = \"rock\"\nvertices",
             "material = \"granite\"\nvertices",
         ));
-        assert!(e.message.contains("granite") && e.line == Some(17), "{e}");
+        assert!(e.message.contains("granite") && e.line == Some(14), "{e}");
         let e = parse_err(&GOOD.replace("poisson_ratio = 0.25", "poisson_ratio = 0.5"));
         assert!(e.message.contains("poisson_ratio"), "{e}");
         let e = parse_err(&GOOD.replace("density = 2750.0", "density = -1.0"));
