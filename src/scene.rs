@@ -411,10 +411,7 @@ vertices = [[-1,-1,2],[1,-1,2],[1,1,2],[-1,1,2],[-1,-1,4],[1,-1,4],[1,1,4],[-1,1
         assert!(e.message.contains("density"), "{e}");
         let e = parse_err(&GOOD.replace("young_modulus = 2.0e10", "young_modulus = nan"));
         assert!(e.message.contains("finite"), "{e}");
-        let e = parse_err(&GOOD.replace(
-            "[-1,-1,4],[1,-1,4],[1,1,4],[-1,1,4]]",
-            "[-1,-1,2]]",
-        ));
+        let e = parse_err(&GOOD.replace("[-1,-1,4],[1,-1,4],[1,1,4],[-1,1,4]]", "[-1,-1,2]]"));
         assert!(
             e.message.contains("coplanar") || e.message.contains("four"),
             "{e}"
