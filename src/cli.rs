@@ -26,6 +26,46 @@ pub struct Cli {
 pub enum Command {
     /// Simulate a scene without any window or GPU; write blocks.csv, contacts.csv, summary.json.
     Run(RunArgs),
+    /// Write a generated scene file (for measuring cost as the model grows).
+    Generate(GenerateArgs),
+    /// Time the rockfall scene with both methods, and the scaling on generated walls.
+    Bench(BenchArgs),
+}
+
+/// Kinds of generated scenes.
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum GeneratedKind {
+    /// A jointed wall of columns of stacked blocks, struck by a rock.
+    Column,
+}
+
+#[derive(Args, Debug)]
+pub struct GenerateArgs {
+    /// What to generate.
+    #[arg(value_enum)]
+    pub kind: GeneratedKind,
+    /// Number of jointed blocks (not counting the ground slab and the rock).
+    #[arg(long, default_value_t = 5)]
+    pub blocks: usize,
+    /// Blocks per column.
+    #[arg(long, default_value_t = 5)]
+    pub layers: usize,
+    /// Output scene file (default: out/column_<N>.toml).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// The rockfall scene to time.
+    #[arg(long, default_value = "scenes/rock_column_rockfall.toml")]
+    pub scene: PathBuf,
+    /// Generated wall sizes for the scaling study (comma separated; empty to skip).
+    #[arg(long, value_delimiter = ',', default_value = "10,100,1000")]
+    pub sizes: Vec<usize>,
+    /// Runs per measurement; the fastest is reported.
+    #[arg(long, default_value_t = 3)]
+    pub repeat: usize,
 }
 
 /// Overrides of the scene's `[solver]` table, shared by the commands that simulate.
@@ -210,4 +250,42 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         );
     }
     Ok(())
+}
+
+/// `dda3d generate`.
+pub fn generate(args: &GenerateArgs) -> Result<(), CliError> {
+    if args.blocks == 0 || args.blocks > 1_000_000 {
+        return Err(CliError::Input(format!(
+            "--blocks must lie in 1..=1000000, got {}",
+            args.blocks
+        )));
+    }
+    if args.layers == 0 {
+        return Err(CliError::Input("--layers must be at least 1".into()));
+    }
+    let text = match args.kind {
+        GeneratedKind::Column => crate::generate::column_wall(args.blocks, args.layers),
+    };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(format!("column_{}.toml", args.blocks)));
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| CliError::Run(format!("{}: {e}", dir.display())))?;
+    }
+    std::fs::write(&out, text).map_err(|e| CliError::Run(format!("{}: {e}", out.display())))?;
+    eprintln!("wrote {}", out.display());
+    Ok(())
+}
+
+/// `dda3d bench`.
+pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
+    if !args.scene.exists() {
+        return Err(CliError::Input(format!(
+            "{}: no such scene file",
+            args.scene.display()
+        )));
+    }
+    crate::bench::run(&args.scene, &args.sizes, args.repeat).map_err(CliError::Run)
 }

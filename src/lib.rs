@@ -7,8 +7,10 @@
 //!
 //! Data flows one way: [`scene`] → [`solver`] → [`snapshot`] → renderer / [`output`].
 
+pub mod bench;
 pub mod cli;
 pub mod contact;
+pub mod generate;
 pub mod geometry;
 pub mod linear;
 pub mod mechanics;

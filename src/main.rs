@@ -5,6 +5,8 @@ fn main() {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Run(args) => cli::run(args),
+        Command::Generate(args) => cli::generate(args),
+        Command::Bench(args) => cli::bench(args),
     };
     if let Err(e) = result {
         eprintln!("error: {}", e.message());

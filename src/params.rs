@@ -75,6 +75,10 @@ pub struct ContactParams {
     /// An open contact closes when its penetration exceeds this fraction of w0 (hysteresis
     /// against open–close chatter, Shi's s0).
     pub close_threshold: f64,
+    /// A closed contact opens when its gap exceeds this fraction of w0 (tension beyond
+    /// p_n · f0 · w0), and tangential displacements below it are not counted as slip or as a
+    /// reversal of slip (Shi's f0; hysteresis for contacts that carry no load).
+    pub open_threshold: f64,
 }
 
 impl Default for ContactParams {
@@ -92,6 +96,7 @@ impl Default for ContactParams {
             max_open_close_iterations: 8,
             warm_start: true,
             close_threshold: 2.0e-7,
+            open_threshold: 2.0e-7,
         }
     }
 }
@@ -191,6 +196,7 @@ impl SolverParams {
             ("solver.contact.eps2", c.eps2),
             ("solver.contact.shear_penalty_ratio", c.shear_penalty_ratio),
             ("solver.contact.close_threshold", c.close_threshold),
+            ("solver.contact.open_threshold", c.open_threshold),
             ("joint.friction_angle", self.joint.friction_angle),
             ("joint.cohesion", self.joint.cohesion),
         ];
@@ -230,8 +236,10 @@ impl SolverParams {
                 self.max_displacement_overshoot
             ));
         }
-        if c.close_threshold < 0.0 {
-            return Err("solver.contact.close_threshold must not be negative".into());
+        if c.close_threshold < 0.0 || c.open_threshold < 0.0 {
+            return Err(
+                "solver.contact.close_threshold and open_threshold must not be negative".into(),
+            );
         }
         if c.max_alm_iterations == 0 || c.max_open_close_iterations == 0 {
             return Err("solver.contact iteration limits must be at least 1".into());

@@ -528,6 +528,9 @@ impl Solver {
                 });
                 let mut rec = match old {
                     Some(mut r) => {
+                        // Warm start: λ and the adapted p_n carry over. Resetting p_n to p_n,1
+                        // every step was tried: with ε2 = 0.01 the multiplier then lags by up to
+                        // 1 % a step, and a standing column slowly rocks itself apart.
                         if !p.contact.warm_start || p.method == Method::Penalty {
                             r.lambda = 0.0;
                             r.penalty = p.contact.initial_penalty;
@@ -663,6 +666,7 @@ impl Solver {
         let tan_phi = p.joint.friction_angle.to_radians().tan();
         let dn_max = self.max_step_penetration();
         let close_tol = cp.close_threshold * self.w0;
+        let state_tol = cp.open_threshold * self.w0;
         let mut d = vec![0.0; 12 * nb];
         let mut oc_passes = 0u32;
         let mut solves = 0u32;
@@ -840,7 +844,10 @@ impl Solver {
                     }
                     ContactState::Lock | ContactState::Slide => {
                         c.rec.normal_force = c.force;
-                        if c.force < 0.0 {
+                        // Shi's opening test, a gap beyond f0·w0, as a force: tension beyond
+                        // p_n,1·f0·w0. The initial penalty, not the adapted one, so that a stiffened
+                        // contact cannot hold tension.
+                        if c.force < -cp.initial_penalty * state_tol {
                             c.rec.state = ContactState::Open;
                             c.rec.lambda = 0.0;
                             c.rec.intact = false;
@@ -857,23 +864,45 @@ impl Solver {
                             } else {
                                 0.0
                             };
-                            if shear > c.force * tan_phi + cohesion {
+                            // Hysteresis: shear displacements below f0·w0 are not slip, so a
+                            // contact that carries no normal force does not flip lock ↔ slide.
+                            if c.shear.norm() > state_tol && shear > c.force * tan_phi + cohesion {
                                 c.rec.state = ContactState::Slide;
                                 c.rec.tau = c.shear.normalize();
                                 c.rec.intact = false;
                                 changed = true;
                             }
-                        } else if c.slip.dot(&c.rec.tau) < 0.0 {
+                        } else if c.slip.dot(&c.rec.tau) < -state_tol {
                             c.rec.state = ContactState::Lock;
                             c.rec.reference = c.cand.xb;
                             changed = true;
-                        } else if c.slip.norm() > 1e-9 * self.w0 {
+                        } else if c.slip.norm() > state_tol {
+                            // Friction follows the slip direction; it has not reversed here, so
+                            // friction along the old direction still did negative work.
                             c.rec.tau = c.slip.normalize();
                         }
                     }
                 }
             }
             timings += t2.elapsed();
+            if changed && std::env::var_os("DDA3D_DEBUG_OC").is_some() {
+                for c in active.iter() {
+                    if c.rec.state != c.start.state {
+                        eprintln!(
+                            "t={:.4} dt={dt:.2e} pass {oc_passes}: {:?} {:?}->{:?} dn={:.3e} N={:.3e} p={:.1e} shear={:.3e} slip={:.3e}",
+                            self.time,
+                            c.cand.key,
+                            c.start.state,
+                            c.rec.state,
+                            c.dn,
+                            c.force,
+                            c.rec.penalty,
+                            c.shear.norm(),
+                            c.slip.norm()
+                        );
+                    }
+                }
+            }
             if !changed {
                 converged_states = true;
                 break;
