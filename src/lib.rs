@@ -7,4 +7,5 @@
 //!
 //! Data flows one way: [`scene`] → [`solver`] → [`snapshot`] → renderer / [`output`].
 
+pub mod render;
 pub mod snapshot;
