@@ -72,3 +72,36 @@ fn capture_throughput_1280x720() {
         r.setup_seconds
     );
 }
+
+#[test]
+#[ignore = "benchmark; run with --ignored --nocapture"]
+fn gif_throughput_1280x720() {
+    let Some(gpu) = gpu_or_skip("gif_throughput_1280x720") else {
+        return;
+    };
+    const N: usize = 30;
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_bench_gif");
+    let _ = std::fs::remove_dir_all(&dir);
+    let mut opts = CaptureOptions::new(&dir);
+    opts.gif = true;
+    let cap = FrameCapture::start_with_gpu(gpu, opts).unwrap();
+    let t = Instant::now();
+    for k in 0..N {
+        cap.submit(slope_snapshot(
+            k as f64 / 30.0,
+            k as u64,
+            3.0 + 0.05 * k as f64,
+            ContactState::Slide,
+        ))
+        .unwrap();
+    }
+    let r = cap.finish().unwrap();
+    let wall = t.elapsed().as_secs_f64();
+    eprintln!(
+        "with --gif: {} frames in {:.2} s = {:.1} frames/s; GIF {:.1} ms/frame (640x360)",
+        r.frames,
+        wall,
+        r.frames as f64 / wall,
+        r.gif_seconds * 1e3 / r.frames as f64
+    );
+}

@@ -61,6 +61,9 @@ pub struct CaptureOptions {
     pub gif_max_width: u32,
     /// PNG encoder threads; 0 = one per core beyond the first, at least one.
     pub encoder_threads: usize,
+    /// Upper bound on MSAA samples (4 by default; 1 turns antialiasing off, about 3× faster
+    /// on the software driver, for quick previews).
+    pub max_msaa_samples: u32,
 }
 
 impl CaptureOptions {
@@ -77,6 +80,7 @@ impl CaptureOptions {
             fps: 30.0,
             gif_max_width: 640,
             encoder_threads: 0,
+            max_msaa_samples: 4,
         }
     }
 
@@ -222,7 +226,8 @@ impl FrameCapture {
     ) -> Result<FrameCapture, RenderError> {
         std::fs::create_dir_all(&opts.out_dir).map_err(|e| RenderError::io(&opts.out_dir, e))?;
         let adapter = gpu.adapter_summary();
-        let offscreen = Offscreen::new(gpu, opts.width, opts.height)?;
+        let offscreen =
+            Offscreen::with_max_samples(gpu, opts.width, opts.height, opts.max_msaa_samples)?;
         let samples = offscreen.samples();
         let csv_path = opts.out_dir.join("frames.csv");
         let mut csv =
@@ -724,7 +729,7 @@ pub fn render_to_png(
 ) -> Result<Camera, RenderError> {
     opts.validate()?;
     let gpu = Gpu::headless()?;
-    let mut off = Offscreen::new(gpu, opts.width, opts.height)?;
+    let mut off = Offscreen::with_max_samples(gpu, opts.width, opts.height, opts.max_msaa_samples)?;
     let (rgba, camera) = render_rgba(&mut off, snapshot, opts)?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| RenderError::io(dir, e))?;

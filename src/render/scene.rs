@@ -305,7 +305,11 @@ impl Scene {
         } else {
             None
         };
-        let shaft = (size * 0.005) as f32;
+        // Arrow thickness follows the scene size, but stays thin next to the blocks when they
+        // are small in a large scene (metre rocks on a kilometre slope).
+        let block = typical_block_size(snap).unwrap_or(size);
+        let shaft = (size * 0.005).min(block * 0.06) as f32;
+        let glyph_len = (size * 0.06).min(block * 0.5) as f32;
         for c in &usable {
             let base = (DVec3::from_array(c.point) - origin).as_vec3();
             let n = DVec3::from_array(c.normal).normalize().as_vec3();
@@ -322,7 +326,7 @@ impl Scene {
                 mesh::push_arrow(&mut arrows, &Arrow::new(base, dir, len, shaft), state_color);
             }
             if draw_normals {
-                let len = (size * 0.06) as f32;
+                let len = glyph_len;
                 let (r, color) = if draw_forces {
                     (shaft * 0.45, srgb_to_linear(hex(NORMAL_GLYPH_SRGB)))
                 } else {
@@ -371,6 +375,30 @@ impl Scene {
     pub fn to_local(&self, world: [f64; 3]) -> Vec3 {
         (DVec3::from_array(world) - self.origin).as_vec3()
     }
+}
+
+/// Median bounding-box diagonal of the blocks (None without blocks).
+fn typical_block_size(snap: &Snapshot) -> Option<f64> {
+    let mut sizes: Vec<f64> = snap
+        .blocks
+        .iter()
+        .filter_map(|b| {
+            let mut lo = DVec3::splat(f64::INFINITY);
+            let mut hi = DVec3::splat(f64::NEG_INFINITY);
+            for v in &b.vertices {
+                let p = DVec3::from_array(*v);
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+            let d = (hi - lo).length();
+            (d.is_finite() && d > 0.0).then_some(d)
+        })
+        .collect();
+    if sizes.is_empty() {
+        return None;
+    }
+    sizes.sort_by(f64::total_cmp);
+    Some(sizes[(sizes.len() - 1) / 2])
 }
 
 /// N per metre of arrow so that the largest force draws about 20 % of the scene size, rounded
@@ -532,5 +560,30 @@ mod tests {
         let f = SceneFrame::of_snapshot(&s);
         assert!(f.size() > 1.0);
         assert!(Scene::build(&s, &SceneStyle::default(), &f).is_ok());
+    }
+
+    #[test]
+    fn arrows_stay_thin_next_to_small_blocks_in_a_big_scene() {
+        let mut s = snap(vec![contact(1000.0, ContactState::Lock)]);
+        // A 1 km fixed "slope" block and three 1 m cubes: the median block is 1 m across.
+        s.blocks[0]
+            .vertices
+            .iter_mut()
+            .for_each(|v| v.iter_mut().for_each(|x| *x *= 1000.0));
+        s.blocks.push(cube("c2", [5.0, 0.0, 1.0], false));
+        s.blocks.push(cube("c3", [7.0, 0.0, 1.0], false));
+        let frame = SceneFrame::of_snapshot(&s);
+        let scene = Scene::build(&s, &SceneStyle::default(), &frame).unwrap();
+        let base = scene.to_local([0.0, 0.0, 1.0]);
+        let radius = scene
+            .arrows
+            .iter()
+            .map(|v| {
+                let r = glam::Vec3::from(v.position) - base;
+                r.truncate().length()
+            })
+            .fold(0.0f32, f32::max);
+        // Head radius = 2.4 × shaft ≤ 2.4 × 0.06 × √3 m.
+        assert!(radius < 0.3, "arrow radius {radius} m next to 1 m blocks");
     }
 }
