@@ -5,7 +5,7 @@
 //! scheme ("DDA-3p") is kept as a baseline. Equation numbers (P1)…(P26) refer to that paper,
 //! plain numbers such as (5.4) to `shared/docs/dda3d-reference.md`.
 //!
-//! Data flows one way: [`scene`] → [`solver`] → [`snapshot`] → renderer / [`output`].
+//! Data flows one way: [`scene`] → [`solver`] → [`snapshot`] → [`render`] / [`output`].
 
 pub mod bench;
 pub mod cli;
@@ -16,6 +16,7 @@ pub mod linear;
 pub mod mechanics;
 pub mod output;
 pub mod params;
+pub mod render;
 pub mod scene;
 pub mod snapshot;
 pub mod solver;

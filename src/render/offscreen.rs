@@ -1,0 +1,288 @@
+//! Off-screen rendering with readback: renders a [`Scene`] into a texture and copies it to a
+//! mappable buffer whose rows are padded to wgpu's `COPY_BYTES_PER_ROW_ALIGNMENT` (256 bytes),
+//! then strips the padding. Two readback buffers let the next frame be drawn while the previous
+//! one is being read ([`Offscreen::submit`] / [`Offscreen::read`]).
+
+use std::sync::mpsc;
+
+use super::camera::Camera;
+use super::overlay::Overlay;
+use super::scene::Scene;
+use super::{Gpu, OFFSCREEN_FORMAT, RenderError, RenderTargets, Renderer};
+
+/// Bytes per row of the readback buffer: `width * 4` rounded up to the copy alignment.
+pub fn padded_bytes_per_row(width: u32) -> u32 {
+    let unpadded = width * 4;
+    let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    unpadded.div_ceil(align) * align
+}
+
+/// Copies `height` rows of `width * 4` bytes out of a buffer with `padded` bytes per row.
+pub fn strip_row_padding(padded_data: &[u8], width: u32, height: u32, padded: u32) -> Vec<u8> {
+    let row = (width * 4) as usize;
+    let mut out = Vec::with_capacity(row * height as usize);
+    for chunk in padded_data.chunks(padded as usize).take(height as usize) {
+        out.extend_from_slice(&chunk[..row.min(chunk.len())]);
+    }
+    out
+}
+
+struct Slot {
+    buffer: wgpu::Buffer,
+    busy: bool,
+}
+
+/// A frame on its way back from the GPU; pass it to [`Offscreen::read`].
+pub struct Pending {
+    slot: usize,
+    submission: wgpu::SubmissionIndex,
+    mapped: mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>,
+}
+
+/// An off-screen render target of fixed size with its own renderer and overlay.
+pub struct Offscreen {
+    gpu: Gpu,
+    renderer: Renderer,
+    overlay: Overlay,
+    width: u32,
+    height: u32,
+    targets: RenderTargets,
+    output: wgpu::Texture,
+    output_view: wgpu::TextureView,
+    padded_row: u32,
+    slots: Vec<Slot>,
+}
+
+impl Offscreen {
+    /// Sets up a `width`×`height` target (RGBA8 sRGB) with 4× MSAA where supported.
+    pub fn new(gpu: Gpu, width: u32, height: u32) -> Result<Offscreen, RenderError> {
+        Offscreen::with_max_samples(gpu, width, height, 4)
+    }
+
+    /// As [`Offscreen::new`] with at most `max_samples` MSAA samples (1 = no MSAA).
+    pub fn with_max_samples(
+        gpu: Gpu,
+        width: u32,
+        height: u32,
+        max_samples: u32,
+    ) -> Result<Offscreen, RenderError> {
+        Offscreen::with_format(gpu, width, height, OFFSCREEN_FORMAT, max_samples)
+    }
+
+    /// As [`Offscreen::with_max_samples`] drawing into `format`: `Rgba8UnormSrgb` (the
+    /// default), or `Rgba8Unorm`, the kind of target a window surface shared with egui is
+    /// (the shader then encodes sRGB itself); the bytes read back are sRGB either way.
+    pub fn with_format(
+        gpu: Gpu,
+        width: u32,
+        height: u32,
+        format: wgpu::TextureFormat,
+        max_samples: u32,
+    ) -> Result<Offscreen, RenderError> {
+        if !matches!(
+            format,
+            wgpu::TextureFormat::Rgba8UnormSrgb | wgpu::TextureFormat::Rgba8Unorm
+        ) {
+            return Err(RenderError::InvalidOptions(format!(
+                "off-screen format {format:?} is not supported (use Rgba8UnormSrgb or Rgba8Unorm)"
+            )));
+        }
+        let limits = gpu.device.limits();
+        let max = limits.max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(RenderError::InvalidOptions(format!(
+                "image size {width}x{height} is outside 1..={max} pixels per side on this GPU"
+            )));
+        }
+        let padded_row = padded_bytes_per_row(width);
+        let buffer_size = padded_row as u64 * height as u64;
+        if buffer_size > limits.max_buffer_size {
+            return Err(RenderError::InvalidOptions(format!(
+                "image size {width}x{height} needs a {buffer_size}-byte readback buffer; \
+                 this GPU allows {}",
+                limits.max_buffer_size
+            )));
+        }
+        let renderer = Renderer::with_max_samples(&gpu, format, max_samples);
+        let overlay = Overlay::new(&gpu.device, format);
+        let targets = renderer.create_targets(&gpu.device, width, height);
+        let output = gpu.device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("dda3d frame"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let output_view = output.create_view(&Default::default());
+        let slots = (0..2)
+            .map(|_| Slot {
+                buffer: gpu.device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some("dda3d readback"),
+                    size: buffer_size,
+                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                    mapped_at_creation: false,
+                }),
+                busy: false,
+            })
+            .collect();
+        gpu.take_error()?;
+        Ok(Offscreen {
+            gpu,
+            renderer,
+            overlay,
+            width,
+            height,
+            targets,
+            output,
+            output_view,
+            padded_row,
+            slots,
+        })
+    }
+
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    pub fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    /// MSAA samples in use.
+    pub fn samples(&self) -> u32 {
+        self.renderer.samples()
+    }
+
+    /// Width / height, for the camera.
+    pub fn aspect(&self) -> f32 {
+        self.width as f32 / self.height as f32
+    }
+
+    /// Draws the scene and queues its copy to a free readback buffer. At most two frames may
+    /// be in flight.
+    pub fn submit(&mut self, scene: &Scene, camera: &Camera) -> Result<Pending, RenderError> {
+        let slot = self.slots.iter().position(|s| !s.busy).ok_or_else(|| {
+            RenderError::InvalidOptions("two frames already in flight; read one first".into())
+        })?;
+        let device = &self.gpu.device;
+        let queue = &self.gpu.queue;
+        self.renderer
+            .prepare(device, queue, scene, camera, self.width, self.height)?;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("dda3d frame"),
+        });
+        self.renderer
+            .encode(&mut encoder, &self.targets, &self.output_view);
+        if scene.overlay {
+            self.overlay.encode(
+                device,
+                queue,
+                &mut encoder,
+                &self.output_view,
+                self.width,
+                self.height,
+                scene,
+                camera,
+            );
+        }
+        let buffer = &self.slots[slot].buffer;
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture: &self.output,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row),
+                    rows_per_image: Some(self.height),
+                },
+            },
+            wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: 1,
+            },
+        );
+        let submission = queue.submit([encoder.finish()]);
+        let (tx, rx) = mpsc::channel();
+        buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        self.slots[slot].busy = true;
+        self.gpu.take_error()?;
+        Ok(Pending {
+            slot,
+            submission,
+            mapped: rx,
+        })
+    }
+
+    /// Waits for a submitted frame and returns its pixels: `width * height * 4` bytes of RGBA
+    /// (sRGB; premultiplied alpha when the background is transparent), top row first.
+    pub fn read(&mut self, pending: Pending) -> Result<Vec<u8>, RenderError> {
+        self.gpu
+            .device
+            .poll(wgpu::PollType::Wait {
+                submission_index: Some(pending.submission),
+                timeout: None,
+            })
+            .map_err(|e| RenderError::Gpu(e.to_string()))?;
+        let mapped = pending
+            .mapped
+            .recv()
+            .map_err(|_| RenderError::Gpu("readback callback never ran".into()))?;
+        mapped.map_err(|e| RenderError::Gpu(format!("readback failed: {e}")))?;
+        let slot = &mut self.slots[pending.slot];
+        let pixels = {
+            let view = slot
+                .buffer
+                .get_mapped_range(..)
+                .map_err(|e| RenderError::Gpu(format!("readback mapping: {e}")))?;
+            strip_row_padding(&view, self.width, self.height, self.padded_row)
+        };
+        slot.buffer.unmap();
+        slot.busy = false;
+        self.gpu.take_error()?;
+        Ok(pixels)
+    }
+
+    /// Renders one frame and waits for it.
+    pub fn render(&mut self, scene: &Scene, camera: &Camera) -> Result<Vec<u8>, RenderError> {
+        let p = self.submit(scene, camera)?;
+        self.read(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn row_padding() {
+        assert_eq!(padded_bytes_per_row(64), 256);
+        assert_eq!(padded_bytes_per_row(65), 512);
+        assert_eq!(padded_bytes_per_row(1280), 5120);
+        assert_eq!(padded_bytes_per_row(1), 256);
+        // 3 rows of 2 pixels, padded to 256 bytes.
+        let mut data = vec![0u8; 256 * 3];
+        for r in 0..3 {
+            for b in 0..8 {
+                data[r * 256 + b] = (r * 10 + b) as u8;
+            }
+        }
+        let out = strip_row_padding(&data, 2, 3, 256);
+        assert_eq!(out.len(), 24);
+        assert_eq!(&out[8..16], &[10, 11, 12, 13, 14, 15, 16, 17]);
+    }
+}

@@ -1,0 +1,589 @@
+//! From a [`Snapshot`] to what the GPU draws: the geometry buffers plus the few numbers the
+//! caption and legends print. Pure CPU work (tested without a GPU).
+
+use glam::{DVec3, Vec3};
+
+use super::RenderError;
+use super::camera::{Camera, CameraOverride};
+use super::mesh::{
+    self, Arrow, EDGE_SRGB, LOCK_SRGB, LineInstance, NORMAL_GLYPH_SRGB, OPEN_SRGB, Rgba,
+    SLIDE_SRGB, SolidVertex, hex, srgb_to_linear,
+};
+use crate::snapshot::{ContactState, Snapshot};
+
+/// What decides a block's colour.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Coloring {
+    /// A fixed palette colour per block index (the same in every frame).
+    #[default]
+    PerBlock,
+    /// Speed of the centroid, |v| (m/s), through a colour map.
+    Velocity,
+    /// Magnitude of the centroid displacement since t = 0 (m), through a colour map.
+    Displacement,
+}
+
+impl Coloring {
+    /// Parses `block`, `velocity` or `displacement` (for a CLI flag).
+    pub fn parse(s: &str) -> Result<Coloring, String> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "block" | "blocks" | "per-block" => Ok(Coloring::PerBlock),
+            "velocity" | "speed" | "v" => Ok(Coloring::Velocity),
+            "displacement" | "disp" | "u" => Ok(Coloring::Displacement),
+            other => Err(format!(
+                "unknown colouring {other:?} (expected block, velocity or displacement)"
+            )),
+        }
+    }
+}
+
+/// Which contact arrows to draw.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ArrowMode {
+    None,
+    /// Unit-length glyphs along the contact normals.
+    Normals,
+    /// Arrows along the normal with length = normal force / scale.
+    #[default]
+    Forces,
+    /// Force arrows, plus thin dark normal glyphs (visible where a force is small).
+    Both,
+}
+
+/// How a frame looks. The defaults make a report figure.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneStyle {
+    pub coloring: Coloring,
+    /// Colour-map range for [`Coloring::Velocity`]/[`Coloring::Displacement`]; `None` = 0 to the
+    /// largest value in the frame.
+    pub field_range: Option<(f64, f64)>,
+    pub arrows: ArrowMode,
+    /// Newtons per metre of force arrow; `None` = chosen so that the largest force in the frame
+    /// is about 20 % of the scene size, rounded to a 1–2–2.5–5 number.
+    pub force_scale: Option<f64>,
+    /// Transparent background (alpha 0) instead of the light grey one.
+    pub transparent: bool,
+    pub grid: bool,
+    pub edges: bool,
+    /// Caption (scene, time, step), legends and the axis triad.
+    pub overlay: bool,
+}
+
+impl Default for SceneStyle {
+    fn default() -> Self {
+        SceneStyle {
+            coloring: Coloring::PerBlock,
+            field_range: None,
+            arrows: ArrowMode::Forces,
+            force_scale: None,
+            transparent: false,
+            grid: true,
+            edges: true,
+            overlay: true,
+        }
+    }
+}
+
+/// The reference box of a picture: where the camera looks, how big arrows and grid cells are,
+/// and the origin the f32 coordinates are measured from. Kept fixed across the frames of an
+/// animation so nothing jumps.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SceneFrame {
+    pub lo: DVec3,
+    pub hi: DVec3,
+}
+
+impl SceneFrame {
+    /// The bounding box of all block vertices (a unit box at the origin when there are none).
+    pub fn of_snapshot(snap: &Snapshot) -> SceneFrame {
+        let mut lo = DVec3::splat(f64::INFINITY);
+        let mut hi = DVec3::splat(f64::NEG_INFINITY);
+        for b in &snap.blocks {
+            for v in &b.vertices {
+                let p = DVec3::from_array(*v);
+                if p.is_finite() {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+        }
+        if lo.is_finite() && hi.is_finite() {
+            SceneFrame::from_box(lo.to_array(), hi.to_array())
+        } else {
+            SceneFrame::from_box([-0.5; 3], [0.5; 3])
+        }
+    }
+
+    /// A box given by two corners (any order). Non-finite input gives a unit box.
+    pub fn from_box(a: [f64; 3], b: [f64; 3]) -> SceneFrame {
+        let (a, b) = (DVec3::from_array(a), DVec3::from_array(b));
+        if !(a.is_finite() && b.is_finite()) {
+            return SceneFrame {
+                lo: DVec3::splat(-0.5),
+                hi: DVec3::splat(0.5),
+            };
+        }
+        SceneFrame {
+            lo: a.min(b),
+            hi: a.max(b),
+        }
+    }
+
+    /// Centre of the box: the origin of the f32 render coordinates.
+    pub fn origin(&self) -> DVec3 {
+        (self.lo + self.hi) * 0.5
+    }
+
+    /// Length of the box diagonal (at least 1 mm), the yardstick for glyph sizes.
+    pub fn size(&self) -> f64 {
+        (self.hi - self.lo).length().max(1e-3)
+    }
+
+    /// The camera that frames this box for an image of the given aspect, with user overrides.
+    pub fn camera(&self, aspect: f32, view: &CameraOverride) -> Camera {
+        let mut cam = Camera::frame(self.lo.to_array(), self.hi.to_array(), aspect);
+        cam.apply_override(view);
+        cam
+    }
+}
+
+/// The text the caption prints.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Caption {
+    pub scene_name: String,
+    pub time: f64,
+    pub step: u64,
+}
+
+/// Colour-map legend.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FieldLegend {
+    pub label: &'static str,
+    pub unit: &'static str,
+    pub min: f64,
+    pub max: f64,
+}
+
+/// Everything one frame draws, in f32 coordinates relative to `origin`.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    pub origin: DVec3,
+    /// Block faces (and nothing else) — lit, depth-tested.
+    pub solids: Vec<SolidVertex>,
+    /// Contact arrows — drawn depth-tested, then again faintly where hidden, so an arrow inside
+    /// or behind a block still reads.
+    pub arrows: Vec<SolidVertex>,
+    /// Outlines and grid.
+    pub lines: Vec<LineInstance>,
+    pub caption: Caption,
+    /// N per metre of arrow in effect, when force arrows are drawn and there are contacts.
+    pub force_scale: Option<f64>,
+    pub field: Option<FieldLegend>,
+    pub contacts_lock: usize,
+    pub contacts_slide: usize,
+    pub transparent: bool,
+    pub overlay: bool,
+    /// Grid spacing in metres, when a grid is drawn.
+    pub grid_step: Option<f64>,
+}
+
+/// Background of opaque frames (sRGB): a light grey that prints well and separates white-ish
+/// blocks from the page.
+pub const BACKGROUND_SRGB: u32 = 0xF4F4F1;
+
+impl Scene {
+    /// Builds the frame. Errors on malformed blocks (face indices out of range, non-finite
+    /// vertices); contacts with non-finite data are skipped.
+    pub fn build(
+        snap: &Snapshot,
+        style: &SceneStyle,
+        frame: &SceneFrame,
+    ) -> Result<Scene, RenderError> {
+        let origin = frame.origin();
+        let size = frame.size();
+        let mut solids = Vec::new();
+        let mut arrows = Vec::new();
+        let mut lines = Vec::new();
+
+        // Colour-map range.
+        let field_value = |b: &crate::snapshot::BlockSnapshot| -> Option<f64> {
+            let v = match style.coloring {
+                Coloring::PerBlock => return None,
+                Coloring::Velocity => DVec3::from_array(b.velocity).length(),
+                Coloring::Displacement => DVec3::from_array(b.displacement).length(),
+            };
+            v.is_finite().then_some(v)
+        };
+        let field = match style.coloring {
+            Coloring::PerBlock => None,
+            c => {
+                let (label, unit) = if c == Coloring::Velocity {
+                    ("speed |v|", "m/s")
+                } else {
+                    ("displacement |u|", "m")
+                };
+                let (min, max) = match style.field_range {
+                    Some((a, b)) if a.is_finite() && b.is_finite() && b > a => (a, b),
+                    _ => {
+                        let max = snap
+                            .blocks
+                            .iter()
+                            .filter(|b| !b.fixed)
+                            .filter_map(field_value)
+                            .fold(0.0, f64::max);
+                        (0.0, max)
+                    }
+                };
+                Some(FieldLegend {
+                    label,
+                    unit,
+                    min,
+                    max,
+                })
+            }
+        };
+
+        let edge = style
+            .edges
+            .then(|| (1.4f32, srgb_to_linear(hex(EDGE_SRGB))));
+        for (i, b) in snap.blocks.iter().enumerate() {
+            let color = match (&field, field_value(b)) {
+                (Some(f), Some(v)) if !b.fixed => {
+                    let t = if f.max > f.min {
+                        (v - f.min) / (f.max - f.min)
+                    } else {
+                        0.0
+                    };
+                    mesh::colormap(t as f32)
+                }
+                _ => mesh::block_color(i, b.fixed),
+            };
+            mesh::push_block(
+                &mut solids,
+                &mut lines,
+                &b.name,
+                &b.vertices,
+                &b.faces,
+                origin,
+                color,
+                edge,
+            )
+            .map_err(|e| RenderError::InvalidSnapshot(e.0))?;
+        }
+
+        // Contacts.
+        let mut contacts_lock = 0;
+        let mut contacts_slide = 0;
+        let usable: Vec<_> = snap
+            .contacts
+            .iter()
+            .filter(|c| {
+                DVec3::from_array(c.point).is_finite()
+                    && DVec3::from_array(c.normal).is_finite()
+                    && DVec3::from_array(c.normal).length() > 1e-12
+                    && c.normal_force.is_finite()
+            })
+            .collect();
+        for c in &usable {
+            match c.state {
+                ContactState::Lock => contacts_lock += 1,
+                ContactState::Slide => contacts_slide += 1,
+                ContactState::Open => {}
+            }
+        }
+        let draw_forces = matches!(style.arrows, ArrowMode::Forces | ArrowMode::Both);
+        let draw_normals = matches!(style.arrows, ArrowMode::Normals | ArrowMode::Both);
+        let max_force = usable
+            .iter()
+            .map(|c| c.normal_force.abs())
+            .fold(0.0, f64::max);
+        let force_scale = if draw_forces && !usable.is_empty() {
+            match style.force_scale {
+                Some(s) if s.is_finite() && s > 0.0 => Some(s),
+                _ => Some(auto_force_scale(max_force, size)),
+            }
+        } else {
+            None
+        };
+        // Arrow thickness follows the scene size, but stays thin next to the blocks when they
+        // are small in a large scene (metre rocks on a kilometre slope).
+        let block = typical_block_size(snap).unwrap_or(size);
+        let shaft = (size * 0.005).min(block * 0.06) as f32;
+        let glyph_len = (size * 0.06).min(block * 0.5) as f32;
+        for c in &usable {
+            let base = (DVec3::from_array(c.point) - origin).as_vec3();
+            let n = DVec3::from_array(c.normal).normalize().as_vec3();
+            let state_color = srgb_to_linear(hex(match c.state {
+                ContactState::Lock => LOCK_SRGB,
+                ContactState::Slide => SLIDE_SRGB,
+                ContactState::Open => OPEN_SRGB,
+            }));
+            if let Some(scale) = force_scale {
+                // The force on block i is +N·n (n points from j toward i); a tensile (negative)
+                // force points the other way.
+                let dir = if c.normal_force >= 0.0 { n } else { -n };
+                let len = (c.normal_force.abs() / scale) as f32;
+                mesh::push_arrow(&mut arrows, &Arrow::new(base, dir, len, shaft), state_color);
+            }
+            if draw_normals {
+                let len = glyph_len;
+                let (r, color) = if draw_forces {
+                    (shaft * 0.45, srgb_to_linear(hex(NORMAL_GLYPH_SRGB)))
+                } else {
+                    (shaft, state_color)
+                };
+                mesh::push_arrow(&mut arrows, &Arrow::new(base, n, len, r), color);
+            }
+        }
+
+        let grid_step = style.grid.then(|| {
+            let lo = (frame.lo - origin).as_vec3();
+            let hi = (frame.hi - origin).as_vec3();
+            mesh::push_grid(&mut lines, lo, hi, origin, 1.0) as f64
+        });
+
+        Ok(Scene {
+            origin,
+            solids,
+            arrows,
+            lines,
+            caption: Caption {
+                scene_name: snap.scene_name.clone(),
+                time: snap.time,
+                step: snap.step,
+            },
+            force_scale,
+            field,
+            contacts_lock,
+            contacts_slide,
+            transparent: style.transparent,
+            overlay: style.overlay,
+            grid_step,
+        })
+    }
+
+    /// Linear background colour (alpha 0 when transparent).
+    pub fn background(&self) -> Rgba {
+        if self.transparent {
+            [0.0; 4]
+        } else {
+            srgb_to_linear(hex(BACKGROUND_SRGB))
+        }
+    }
+
+    /// Local (f32) position of a world point.
+    pub fn to_local(&self, world: [f64; 3]) -> Vec3 {
+        (DVec3::from_array(world) - self.origin).as_vec3()
+    }
+}
+
+/// Median bounding-box diagonal of the blocks (None without blocks).
+fn typical_block_size(snap: &Snapshot) -> Option<f64> {
+    let mut sizes: Vec<f64> = snap
+        .blocks
+        .iter()
+        .filter_map(|b| {
+            let mut lo = DVec3::splat(f64::INFINITY);
+            let mut hi = DVec3::splat(f64::NEG_INFINITY);
+            for v in &b.vertices {
+                let p = DVec3::from_array(*v);
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+            let d = (hi - lo).length();
+            (d.is_finite() && d > 0.0).then_some(d)
+        })
+        .collect();
+    if sizes.is_empty() {
+        return None;
+    }
+    sizes.sort_by(f64::total_cmp);
+    Some(sizes[(sizes.len() - 1) / 2])
+}
+
+/// N per metre of arrow so that the largest force draws about 20 % of the scene size, rounded
+/// up to a number a legend reads cleanly.
+pub fn auto_force_scale(max_force: f64, scene_size: f64) -> f64 {
+    if !(max_force.is_finite() && max_force > 0.0) {
+        return 1.0;
+    }
+    mesh::nice_ceil(max_force / (0.20 * scene_size.max(1e-3)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::snapshot::*;
+
+    fn cube(name: &str, at: [f64; 3], fixed: bool) -> BlockSnapshot {
+        let v: Vec<[f64; 3]> = (0..8)
+            .map(|i| {
+                [
+                    at[0] + (i & 1) as f64,
+                    at[1] + ((i >> 1) & 1) as f64,
+                    at[2] + ((i >> 2) & 1) as f64,
+                ]
+            })
+            .collect();
+        let faces = vec![
+            vec![0, 2, 3, 1],
+            vec![4, 5, 7, 6],
+            vec![0, 1, 5, 4],
+            vec![1, 3, 7, 5],
+            vec![3, 2, 6, 7],
+            vec![2, 0, 4, 6],
+        ];
+        BlockSnapshot {
+            name: name.into(),
+            fixed,
+            vertices: v,
+            faces,
+            centroid: [at[0] + 0.5, at[1] + 0.5, at[2] + 0.5],
+            velocity: [0.0, 0.0, -2.0],
+            displacement: [0.0, 0.0, -0.5],
+        }
+    }
+
+    fn snap(contacts: Vec<ContactSnapshot>) -> Snapshot {
+        Snapshot {
+            scene_name: "two cubes".into(),
+            time: 0.25,
+            step: 10,
+            blocks: vec![
+                cube("base", [0.0; 3], true),
+                cube("top", [0.0, 0.0, 1.0], false),
+            ],
+            contacts,
+            stats: StepStats::default(),
+        }
+    }
+
+    fn contact(f: f64, state: ContactState) -> ContactSnapshot {
+        ContactSnapshot {
+            block_i: 1,
+            block_j: 0,
+            mode: ContactMode::VertexFace,
+            state,
+            point: [0.0, 0.0, 1.0],
+            normal: [0.0, 0.0, 1.0],
+            normal_force: f,
+            shear_force: 0.0,
+            penetration: 0.0,
+            penalty: 0.0,
+            lambda: 0.0,
+        }
+    }
+
+    #[test]
+    fn force_arrow_length_follows_scale() {
+        let s = snap(vec![contact(1000.0, ContactState::Lock)]);
+        let style = SceneStyle {
+            force_scale: Some(500.0),
+            grid: false,
+            ..Default::default()
+        };
+        let frame = SceneFrame::of_snapshot(&s);
+        let scene = Scene::build(&s, &style, &frame).unwrap();
+        assert_eq!(scene.force_scale, Some(500.0));
+        // 1000 N at 500 N/m → 2 m arrow from the contact point along +z.
+        let base = scene.to_local([0.0, 0.0, 1.0]);
+        let top = scene
+            .arrows
+            .iter()
+            .map(|v| v.position[2] - base.z)
+            .fold(f32::MIN, f32::max);
+        assert!((top - 2.0).abs() < 1e-4, "arrow top {top}");
+        assert_eq!(scene.contacts_lock, 1);
+        let lock = srgb_to_linear(hex(LOCK_SRGB));
+        assert!(scene.arrows.iter().all(|v| v.color == lock));
+    }
+
+    #[test]
+    fn auto_scale_and_slide_colour() {
+        let s = snap(vec![
+            contact(60154.0, ContactState::Slide),
+            contact(33204.0, ContactState::Lock),
+        ]);
+        let frame = SceneFrame::of_snapshot(&s);
+        let scene = Scene::build(&s, &SceneStyle::default(), &frame).unwrap();
+        let scale = scene.force_scale.unwrap();
+        let longest = 60154.0 / scale;
+        assert!(longest <= 0.20 * frame.size() + 1e-9 && longest > 0.08 * frame.size());
+        let slide = srgb_to_linear(hex(SLIDE_SRGB));
+        assert!(scene.arrows.iter().any(|v| v.color == slide));
+        assert_eq!((scene.contacts_lock, scene.contacts_slide), (1, 1));
+    }
+
+    #[test]
+    fn no_contacts_no_arrows_and_grid_present() {
+        let s = snap(vec![]);
+        let scene = Scene::build(&s, &SceneStyle::default(), &SceneFrame::of_snapshot(&s)).unwrap();
+        assert!(scene.arrows.is_empty());
+        assert!(scene.force_scale.is_none());
+        assert!(scene.grid_step.is_some());
+        assert_eq!(scene.solids.len(), 2 * 6 * 2 * 3);
+        // 24 outline segments, the rest grid.
+        assert!(scene.lines.len() > 24);
+    }
+
+    #[test]
+    fn field_colouring_and_fixed_muted() {
+        let s = snap(vec![]);
+        let style = SceneStyle {
+            coloring: Coloring::Velocity,
+            ..Default::default()
+        };
+        let scene = Scene::build(&s, &style, &SceneFrame::of_snapshot(&s)).unwrap();
+        let f = scene.field.clone().unwrap();
+        assert_eq!((f.min, f.max), (0.0, 2.0));
+        // Fixed block keeps the stone grey, the moving one takes the top of the map.
+        assert_eq!(scene.solids[0].color, mesh::block_color(0, true));
+        assert_eq!(scene.solids.last().unwrap().color, mesh::colormap(1.0));
+    }
+
+    #[test]
+    fn bad_input_is_an_error_or_skipped() {
+        let mut s = snap(vec![contact(f64::NAN, ContactState::Lock)]);
+        let frame = SceneFrame::of_snapshot(&s);
+        let scene = Scene::build(&s, &SceneStyle::default(), &frame).unwrap();
+        assert!(scene.arrows.is_empty());
+        s.blocks[1].faces[0][0] = 42;
+        let err = Scene::build(&s, &SceneStyle::default(), &frame).unwrap_err();
+        assert!(err.to_string().contains("top"), "{err}");
+        assert!(matches!(err, RenderError::InvalidSnapshot(_)));
+    }
+
+    #[test]
+    fn empty_snapshot_frames_a_unit_box() {
+        let mut s = snap(vec![]);
+        s.blocks.clear();
+        let f = SceneFrame::of_snapshot(&s);
+        assert!(f.size() > 1.0);
+        assert!(Scene::build(&s, &SceneStyle::default(), &f).is_ok());
+    }
+
+    #[test]
+    fn arrows_stay_thin_next_to_small_blocks_in_a_big_scene() {
+        let mut s = snap(vec![contact(1000.0, ContactState::Lock)]);
+        // A 1 km fixed "slope" block and three 1 m cubes: the median block is 1 m across.
+        s.blocks[0]
+            .vertices
+            .iter_mut()
+            .for_each(|v| v.iter_mut().for_each(|x| *x *= 1000.0));
+        s.blocks.push(cube("c2", [5.0, 0.0, 1.0], false));
+        s.blocks.push(cube("c3", [7.0, 0.0, 1.0], false));
+        let frame = SceneFrame::of_snapshot(&s);
+        let scene = Scene::build(&s, &SceneStyle::default(), &frame).unwrap();
+        let base = scene.to_local([0.0, 0.0, 1.0]);
+        let radius = scene
+            .arrows
+            .iter()
+            .map(|v| {
+                let r = glam::Vec3::from(v.position) - base;
+                r.truncate().length()
+            })
+            .fold(0.0f32, f32::max);
+        // Head radius = 2.4 × shaft ≤ 2.4 × 0.06 × √3 m.
+        assert!(radius < 0.3, "arrow radius {radius} m next to 1 m blocks");
+    }
+}
