@@ -30,6 +30,8 @@ pub enum Command {
     Generate(GenerateArgs),
     /// Time the rockfall scene with both methods, and the scaling on generated walls.
     Bench(BenchArgs),
+    /// Open the interactive viewer (`dda3d SCENE.toml` is short for `dda3d view SCENE.toml`).
+    View(crate::ui::ViewArgs),
 }
 
 /// Kinds of generated scenes.

@@ -20,3 +20,4 @@ pub mod render;
 pub mod scene;
 pub mod snapshot;
 pub mod solver;
+pub mod ui;

@@ -335,6 +335,25 @@ impl FrameCapture {
         }
     }
 
+    /// As [`FrameCapture::submit`], but returns `Ok(false)` instead of blocking when the
+    /// pipeline is full: the interactive viewer records without stalling its window and simply
+    /// skips the steps that arrive while the writer is busy.
+    pub fn try_submit(&self, snapshot: Snapshot) -> Result<bool, RenderError> {
+        let Some(tx) = &self.tx else {
+            return Err(RenderError::Stopped("capture already finished".into()));
+        };
+        match tx.try_send(snapshot) {
+            Ok(()) => {
+                self.submitted.fetch_add(1, Ordering::Relaxed);
+                Ok(true)
+            }
+            Err(mpsc::TrySendError::Full(_)) => Ok(false),
+            Err(mpsc::TrySendError::Disconnected(_)) => Err(self.failure().unwrap_or_else(|| {
+                RenderError::Stopped("render thread ended unexpectedly".into())
+            })),
+        }
+    }
+
     /// Snapshots accepted so far.
     pub fn submitted(&self) -> usize {
         self.submitted.load(Ordering::Relaxed)
