@@ -53,10 +53,16 @@ struct Wake;
 /// Opens the window and runs until it is closed (or `--exit-after-frames`).
 pub fn run(opts: Options) -> Result<(), CliError> {
     let event_loop = EventLoop::<Wake>::with_user_event().build().map_err(|e| {
-        CliError::Run(format!(
-            "cannot open a window: {e} (no X11 or Wayland display; set DISPLAY or \
-                 WAYLAND_DISPLAY, or run under xvfb-run)"
-        ))
+        let no_display = ["DISPLAY", "WAYLAND_DISPLAY", "WAYLAND_SOCKET"]
+            .iter()
+            .all(|v| std::env::var_os(v).is_none_or(|s| s.is_empty()));
+        CliError::Run(if no_display {
+            "cannot open a window: no X11 or Wayland display (DISPLAY and WAYLAND_DISPLAY \
+                 are not set); for a virtual one, run under xvfb-run"
+                .into()
+        } else {
+            format!("cannot open a window: {e}")
+        })
     })?;
     let proxy = event_loop.create_proxy();
     let mut app = App {
@@ -282,9 +288,19 @@ impl Viewer {
             wgpu::InstanceDescriptor::new_with_display_handle(Box::new(el.owned_display_handle()))
                 .with_env(),
         );
-        let surface = instance
-            .create_surface(window.clone())
-            .map_err(|e| CliError::Run(format!("cannot draw into the window: {e}")))?;
+        let surface = match instance.create_surface(window.clone()) {
+            Ok(s) => s,
+            Err(e) => {
+                // With no usable backend at all, say what to install, as `render` does.
+                let any = pollster::block_on(
+                    instance.request_adapter(&wgpu::RequestAdapterOptions::default()),
+                );
+                return Err(match any {
+                    Err(_) => CliError::Input(RenderError::NoAdapter.to_string()),
+                    Ok(_) => CliError::Run(format!("cannot draw into the window: {e}")),
+                });
+            }
+        };
         let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
@@ -641,7 +657,7 @@ impl Viewer {
         let gpu = self.gpu.clone();
         let tx = self.bg_tx.clone();
         let proxy = self.proxy.clone();
-        self.ui.info("writing screenshot…");
+        self.ui.info("writing screenshot...");
         let spawned = std::thread::Builder::new()
             .name("dda3d-screenshot".into())
             .spawn(move || {
@@ -666,7 +682,7 @@ impl Viewer {
     fn toggle_record(&mut self) {
         if let Some(rec) = self.recording.take() {
             self.ui.recording = None;
-            self.ui.info("finishing recording…");
+            self.ui.info("finishing recording...");
             let tx = self.bg_tx.clone();
             let proxy = self.proxy.clone();
             // Finishing waits for the PNG encoders; keep that off the window thread.

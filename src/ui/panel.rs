@@ -651,7 +651,7 @@ fn speed_label(s: Speed) -> String {
 
 fn toolbar(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
     let Some(frame) = state.frame.clone() else {
-        ui.label("starting…");
+        ui.label("starting...");
         return;
     };
     ui.horizontal(|ui| {
@@ -679,7 +679,7 @@ fn toolbar(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
             }));
         }
         if icon_button(ui, 70.0, Icon::Step, "Step", None)
-            .on_hover_text("Advance one time step, then pause  [→ or S]")
+            .on_hover_text("Advance one time step, then pause  [Right arrow or S]")
             .clicked()
         {
             actions.push(Action::Sim(Command::Step));
@@ -732,7 +732,7 @@ fn toolbar(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
         let (text, color) = match frame.state {
             RunState::Running => ("RUNNING", OK_GREEN),
             RunState::Paused => ("PAUSED", Color32::from_gray(90)),
-            RunState::Finished => ("END TIME REACHED", Color32::from_rgb(0x2F, 0x5F, 0xB0)),
+            RunState::Finished => ("AT END TIME", Color32::from_rgb(0x2F, 0x5F, 0xB0)),
             RunState::Failed => ("SOLVER ERROR", ERROR_RED),
         };
         ui.label(RichText::new(text).strong().color(color));
@@ -780,25 +780,6 @@ fn toolbar(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
                 .clicked()
             {
                 actions.push(Action::Screenshot);
-            }
-            if let Some(r) = &state.recording {
-                ui.label(
-                    RichText::new(format!("● REC {} frames", r.frames))
-                        .color(ERROR_RED)
-                        .strong(),
-                )
-                .on_hover_text(r.dir.display().to_string());
-            }
-            let fade = Duration::from_secs(8);
-            if let Some(m) = &state.message
-                && m.at.elapsed() < fade
-            {
-                let c = if m.error {
-                    ERROR_RED
-                } else {
-                    Color32::from_gray(70)
-                };
-                ui.add(egui::Label::new(RichText::new(&m.text).color(c)).truncate());
             }
         });
     });
@@ -941,7 +922,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
                     ui,
                     "ε2",
                     "(P24) Force tolerance: ALM iterations also require \
-                     ‖λ_k − λ_k−1‖ / ‖λ_k−1‖ < ε2 (relative change of the normal contact forces). \
+                     |λ_k − λ_k−1| / |λ_k−1| < ε2 (relative change of the normal contact forces). \
                      The paper recommends 0 < ε2 < 0.1 and uses 0.01.",
                 )
             });
@@ -1528,7 +1509,7 @@ fn plots(ui: &mut egui::Ui, state: &mut UiState) {
         let pmean = series(recs, |r| lg(r.penalty_mean), max);
         let pmin = series(recs, |r| lg(r.penalty_min), min);
         small_plot("penalty", h)
-            .y_axis_formatter(|m, _| format!("{}", num(10f64.powf(m.value))))
+            .y_axis_formatter(|m, _| num(10f64.powf(m.value)))
             .show(ui, |p| {
                 p.line(Line::new("max", PlotPoints::from(pmax)).color(red));
                 p.line(Line::new("mean", PlotPoints::from(pmean)).color(ACCENT));
@@ -1549,7 +1530,7 @@ fn plots(ui: &mut egui::Ui, state: &mut UiState) {
         plot_title(
             ui,
             "Kinetic energy (kJ)",
-            "½ vᵀMv over all blocks after each step.",
+            "Kinetic energy 1/2 v^T M v summed over all blocks after each step.",
         );
         let ke = series(recs, |r| r.kinetic_energy * 1e-3, max);
         small_plot("ke", h).show(ui, |p| {
@@ -1668,8 +1649,126 @@ fn view_3d(
         paint_overlay(&painter, scene, &state.view.camera, rect);
     }
 
+    if let Some(i) = state.selected
+        && let Some(b) = snap.blocks.get(i)
+    {
+        selection_card(&painter, rect, state, snap, i, b);
+    }
+    status_toasts(ui, &painter, rect, state);
+
     if response.hovered() && !response.dragged() {
         ui.ctx().set_cursor_icon(egui::CursorIcon::Crosshair);
+    }
+}
+
+/// A translucent card with lines of text, anchored at `anchor` of `rect` (inset by a margin).
+fn card(painter: &egui::Painter, rect: Rect, anchor: Align2, lines: &[(String, Color32, bool)]) {
+    let galleys: Vec<_> = lines
+        .iter()
+        .map(|(t, c, strong)| {
+            let font = if *strong {
+                FontId::proportional(15.0)
+            } else {
+                FontId::proportional(13.0)
+            };
+            painter.layout_no_wrap(t.clone(), font, *c)
+        })
+        .collect();
+    let w = galleys.iter().map(|g| g.size().x).fold(0.0, f32::max);
+    let h: f32 = galleys.iter().map(|g| g.size().y + 2.0).sum();
+    let pad = 18.0;
+    let inner = rect.shrink(pad);
+    let r = anchor.align_size_within_rect(Vec2::new(w, h), inner);
+    painter.rect_filled(
+        r.expand(7.0),
+        5.0,
+        Color32::from_rgba_unmultiplied(255, 255, 255, 215),
+    );
+    let mut y = r.min.y;
+    for (g, (_, c, _)) in galleys.into_iter().zip(lines) {
+        let gh = g.size().y;
+        painter.galley(Pos2::new(r.min.x, y), g, *c);
+        y += gh + 2.0;
+    }
+}
+
+/// The selected block's vital numbers, top right of the view (the full contact list is in
+/// the panel).
+fn selection_card(
+    painter: &egui::Painter,
+    rect: Rect,
+    state: &UiState,
+    snap: &Snapshot,
+    i: usize,
+    b: &crate::snapshot::BlockSnapshot,
+) {
+    let text = Color32::from_gray(25);
+    let dim = Color32::from_gray(80);
+    let u = DVec3::from_array(b.displacement).length();
+    let v = DVec3::from_array(b.velocity).length();
+    let contacts: Vec<_> = snap
+        .contacts
+        .iter()
+        .filter(|c| c.block_i == i || c.block_j == i)
+        .collect();
+    let n: f64 = contacts.iter().map(|c| c.normal_force).sum();
+    let sliding = contacts
+        .iter()
+        .filter(|c| c.state == ContactState::Slide)
+        .count();
+    let mut lines = vec![(
+        format!("{}{}", b.name, if b.fixed { " (fixed)" } else { "" }),
+        ACCENT,
+        true,
+    )];
+    if let Some(info) = state.blocks.get(i) {
+        lines.push((format!("mass {} kg", num(info.mass)), dim, false));
+    }
+    lines.push((
+        format!("|u| = {}    |v| = {} m/s", length(u), num(v)),
+        text,
+        false,
+    ));
+    lines.push((
+        format!(
+            "{} contacts ({} sliding), Σ N = {}",
+            contacts.len(),
+            sliding,
+            format_force(n)
+        ),
+        text,
+        false,
+    ));
+    lines.push(("details in the panel · Esc to clear".into(), dim, false));
+    card(painter, rect, Align2::RIGHT_TOP, &lines);
+}
+
+/// Recording indicator and the latest message, bottom centre of the view.
+fn status_toasts(ui: &egui::Ui, painter: &egui::Painter, rect: Rect, state: &UiState) {
+    let mut lines = Vec::new();
+    if let Some(r) = &state.recording {
+        lines.push((
+            format!("REC  {} frames to {}", r.frames, r.dir.display()),
+            ERROR_RED,
+            true,
+        ));
+    }
+    const SHOW: Duration = Duration::from_secs(8);
+    if let Some(m) = &state.message {
+        let age = m.at.elapsed();
+        if age < SHOW {
+            let c = if m.error {
+                ERROR_RED
+            } else {
+                Color32::from_gray(40)
+            };
+            lines.push((m.text.clone(), c, false));
+            // Redraw when it should disappear, even if nothing else moves.
+            ui.ctx().request_repaint_after(SHOW - age);
+        }
+    }
+    if !lines.is_empty() {
+        card(painter, rect, Align2::CENTER_BOTTOM, &lines);
     }
 }
 

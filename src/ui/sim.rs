@@ -506,7 +506,7 @@ impl Sim {
     fn do_step(&mut self) {
         self.step_once = false;
         let t0 = Instant::now();
-        let result = self.solver.step().map(|s| s.clone());
+        let result = self.solver.step().cloned();
         let busy = t0.elapsed();
         match result {
             Ok(stats) => {

@@ -1,0 +1,214 @@
+//! The interactive viewer as CI sees it: `dda3d view SCENE --screenshot FILE --exit-after-frames N`
+//! under Xvfb, and its one-line errors for bad input.
+//!
+//! Without `xvfb-run` or a GPU adapter (hardware or Mesa's software Vulkan driver) the window
+//! test prints a note and passes, unless `DDA3D_REQUIRE_GPU=1` (set by `.ci/run`) makes that a
+//! failure.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use dda3d::render::gpu_required_by_env;
+
+const WIDTH: u32 = 1280;
+const HEIGHT: u32 = 720;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_dda3d"))
+}
+
+fn scene(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name)
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("dda3d-viewer-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// Skips (returns false with a note) or fails, as the GPU policy says.
+fn skip_or_fail(why: &str) -> bool {
+    if gpu_required_by_env() {
+        panic!("{why} (DDA3D_REQUIRE_GPU is set, so the viewer test may not be skipped)");
+    }
+    eprintln!("note: viewer window test skipped: {why}");
+    false
+}
+
+fn have_xvfb_run() -> bool {
+    Command::new("sh")
+        .args(["-c", "command -v xvfb-run"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
+}
+
+/// Fraction of pixels in the rectangle that differ clearly from its first pixel.
+fn variation(img: &image::RgbImage, x0: u32, y0: u32, x1: u32, y1: u32) -> f64 {
+    let first = *img.get_pixel(x0, y0);
+    let mut differ = 0usize;
+    let mut n = 0usize;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let p = img.get_pixel(x, y);
+            let d: i32 = (0..3).map(|k| (p[k] as i32 - first[k] as i32).abs()).sum();
+            if d > 24 {
+                differ += 1;
+            }
+            n += 1;
+        }
+    }
+    differ as f64 / n as f64
+}
+
+/// Whether any pixel of the rectangle is within `tol` (per channel) of `rgb`.
+fn contains_color(img: &image::RgbImage, rect: [u32; 4], rgb: [u8; 3], tol: i32) -> bool {
+    let [x0, y0, x1, y1] = rect;
+    (y0..y1).any(|y| {
+        (x0..x1).any(|x| {
+            let p = img.get_pixel(x, y);
+            (0..3).all(|k| (p[k] as i32 - rgb[k] as i32).abs() <= tol)
+        })
+    })
+}
+
+#[test]
+fn window_screenshot_under_xvfb() {
+    if !have_xvfb_run() {
+        skip_or_fail("xvfb-run is not installed (Debian: apt-get install xvfb xauth)");
+        return;
+    }
+    let dir = tmp("shot");
+    let png = dir.join("window.png");
+    let runtime = dir.join("xdg");
+    std::fs::create_dir_all(&runtime).unwrap();
+    let mut child = Command::new("xvfb-run")
+        // -a: a free display number, so parallel runs do not collide.
+        .args(["-a", "-s", "-screen 0 1600x900x24"])
+        .arg(env!("CARGO_BIN_EXE_dda3d"))
+        .arg("view")
+        .arg(scene("rock_column_rockfall.toml"))
+        .args(["--size", &format!("{WIDTH}x{HEIGHT}")])
+        .arg("--screenshot")
+        .arg(&png)
+        .args(["--exit-after-frames", "40"])
+        .arg("--out")
+        .arg(dir.join("out"))
+        .env("XDG_RUNTIME_DIR", &runtime)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start xvfb-run");
+    let deadline = Instant::now() + Duration::from_secs(300);
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("the viewer did not exit within 300 s");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let out = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !status.success() {
+        if stderr.contains("no GPU adapter") {
+            skip_or_fail("no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)");
+            return;
+        }
+        panic!("viewer failed ({status}):\n{stderr}");
+    }
+    assert!(png.exists(), "no screenshot written; stderr:\n{stderr}");
+    let img = image::open(&png).expect("a readable PNG").to_rgb8();
+    assert_eq!(
+        (img.width(), img.height()),
+        (WIDTH, HEIGHT),
+        "the screenshot has the window's size"
+    );
+
+    // Left panel (parameters) and the 3-D view to its right, away from the toolbar and plots.
+    let panel = [8, 50, 290, 480];
+    let view = [480, 60, 1270, 500];
+    let pv = variation(&img, panel[0], panel[1], panel[2], panel[3]);
+    let vv = variation(&img, view[0], view[1], view[2], view[3]);
+    assert!(
+        pv > 0.02,
+        "panel region is uniform ({pv:.4} of pixels differ)"
+    );
+    assert!(
+        vv > 0.02,
+        "3-D region is uniform ({vv:.4} of pixels differ)"
+    );
+    // The 3-D view shows its light-grey background (so it was drawn, with the right sRGB
+    // handling), and the panel its own fill.
+    assert!(
+        contains_color(&img, view, [0xF4, 0xF4, 0xF1], 3),
+        "3-D background colour not found in the view region"
+    );
+    assert!(
+        contains_color(&img, panel, [0xFA, 0xFA, 0xF8], 3),
+        "panel colour not found in the panel region"
+    );
+    assert!(
+        stderr.contains("frames in"),
+        "the exit report is printed:\n{stderr}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_scene_is_a_one_line_error_with_status_2() {
+    let dir = tmp("bad");
+    let bad = dir.join("bad.toml");
+    std::fs::write(&bad, "name = \"x\"\n[[blocks]]\nmaterial = \"granite\"\nbox = { size = [1.0, 1.0, 1.0], center = [0.0, 0.0, 0.0] }\n").unwrap();
+    for args in [
+        vec!["view".to_string(), bad.display().to_string()],
+        // The shortcut `dda3d SCENE.toml`.
+        vec![bad.display().to_string()],
+        vec![
+            "view".to_string(),
+            dir.join("missing.toml").display().to_string(),
+        ],
+    ] {
+        // No display is needed: the scene is read before any window opens.
+        let out = bin()
+            .args(&args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+        assert!(err.starts_with("error: "), "{err}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn bad_options_are_rejected_before_opening_a_window() {
+    let rock = scene("rock_column_rockfall.toml");
+    for extra in [
+        vec!["--size", "12x7"],
+        vec!["--speed", "-2"],
+        vec!["--msaa", "3"],
+        vec!["--exit-after-frames", "0"],
+    ] {
+        let out = bin()
+            .arg("view")
+            .arg(&rock)
+            .args(&extra)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{extra:?}");
+    }
+}
