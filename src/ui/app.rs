@@ -462,6 +462,21 @@ impl Viewer {
         self.egui_state
             .handle_platform_output(&self.window, out.platform_output);
         self.apply(actions);
+        // egui's texture updates (font atlas) apply even when this frame is not drawn, or
+        // later frames would miss glyphs.
+        let ppp = out.pixels_per_point;
+        let primitives = self.egui_ctx.tessellate(out.shapes, ppp);
+        for (id, deltas) in &out.textures_delta.set {
+            for delta in deltas {
+                self.egui_painter
+                    .update_texture(&self.gpu.device, &self.gpu.queue, *id, delta);
+            }
+        }
+        let free_textures = |painter: &mut EguiPainter| {
+            for id in &out.textures_delta.free {
+                painter.free_texture(id);
+            }
+        };
 
         tm.mark("ui");
         // 3. The surface.
@@ -474,10 +489,12 @@ impl Viewer {
                 t
             }
             wgpu::CurrentSurfaceTexture::Timeout | wgpu::CurrentSurfaceTexture::Occluded => {
+                free_textures(&mut self.egui_painter);
                 self.next_repaint = Some(Instant::now() + Duration::from_millis(50));
                 return Ok(Flow::Continue);
             }
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
+                free_textures(&mut self.egui_painter);
                 let size = self.window.inner_size();
                 self.resize(size);
                 return Ok(Flow::Continue);
@@ -495,7 +512,6 @@ impl Viewer {
         let (sw, sh) = (surface_tex.texture.width(), surface_tex.texture.height());
 
         // 4. The 3-D view into its texture, at the view's size in pixels.
-        let ppp = out.pixels_per_point;
         let r = self.ui.view_rect;
         let (vw, vh) = if r.is_positive() {
             (
@@ -532,12 +548,6 @@ impl Viewer {
         tm.mark("3d");
         // 5. egui into the surface (and into the capture texture for --screenshot).
         let capture_now = self.exit_after.is_some_and(|n| self.frames + 1 >= n);
-        let primitives = self.egui_ctx.tessellate(out.shapes, ppp);
-        for (id, deltas) in &out.textures_delta.set {
-            for delta in deltas {
-                self.egui_painter.update_texture(device, queue, *id, delta);
-            }
-        }
         let screen = Screen {
             size_in_pixels: [sw, sh],
             pixels_per_point: ppp,
@@ -574,9 +584,7 @@ impl Viewer {
         self.window.pre_present_notify();
         queue.present(surface_tex);
         tm.mark("present");
-        for id in &out.textures_delta.free {
-            self.egui_painter.free_texture(id);
-        }
+        free_textures(&mut self.egui_painter);
         if let Err(e) = self.gpu.take_error() {
             self.ui.error(e.to_string());
         }

@@ -788,6 +788,15 @@ fn toolbar(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
 // ---------------------------------------------------------------------------------------------
 // Solver parameters
 
+/// A slider that leaves values outside its range alone (a scene may set any valid value;
+/// merely showing it must not change it), while keeping new edits inside the range.
+fn slider<Num: egui::emath::Numeric>(
+    value: &mut Num,
+    range: std::ops::RangeInclusive<Num>,
+) -> egui::Slider<'_> {
+    egui::Slider::new(value, range).clamping(egui::SliderClamping::Edits)
+}
+
 fn param_label(ui: &mut egui::Ui, text: &str, tip: &str) {
     ui.label(text).on_hover_text(tip);
 }
@@ -839,7 +848,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
                  warns it should not be too small.",
             );
             ui.add(
-                egui::Slider::new(&mut e.contact.initial_penalty, young * 1e-6..=young * 100.0)
+                slider(&mut e.contact.initial_penalty, young * 1e-6..=young * 100.0)
                     .logarithmic(true)
                     .custom_formatter(|v, _| num(v))
                     .suffix(" N/m"),
@@ -858,7 +867,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
             });
             ui.add_enabled(
                 alm,
-                egui::Slider::new(&mut e.contact.alpha, 1.01..=1000.0)
+                slider(&mut e.contact.alpha, 1.01..=1000.0)
                     .logarithmic(true)
                     .custom_formatter(|v, _| num(v)),
             );
@@ -875,7 +884,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
             });
             ui.add_enabled(
                 alm,
-                egui::Slider::new(&mut e.contact.beta, 0.01..=0.99).fixed_decimals(2),
+                slider(&mut e.contact.beta, 0.01..=0.99).fixed_decimals(2),
             );
             ui.label("");
             ui.end_row();
@@ -890,7 +899,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
             });
             ui.add_enabled(
                 alm,
-                egui::Slider::new(&mut e.contact.gamma, 0.01..=1000.0)
+                slider(&mut e.contact.gamma, 0.01..=1000.0)
                     .logarithmic(true)
                     .custom_formatter(|v, _| num(v))
                     .suffix(" E"),
@@ -909,7 +918,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
             });
             ui.add_enabled(
                 alm,
-                egui::Slider::new(&mut e.contact.eps1, 1e-4..=0.5)
+                slider(&mut e.contact.eps1, 1e-4..=0.5)
                     .logarithmic(true)
                     .custom_formatter(|v, _| num(v)),
             );
@@ -928,7 +937,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
             });
             ui.add_enabled(
                 alm,
-                egui::Slider::new(&mut e.contact.eps2, 1e-4..=0.5)
+                slider(&mut e.contact.eps2, 1e-4..=0.5)
                     .logarithmic(true)
                     .custom_formatter(|v, _| num(v)),
             );
@@ -942,7 +951,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
                  force exceeds N·tan φ (+ cohesion). The paper's examples use 35°.",
             );
             ui.add(
-                egui::Slider::new(&mut e.joint.friction_angle, 0.0..=89.0)
+                slider(&mut e.joint.friction_angle, 0.0..=89.0)
                     .fixed_decimals(1)
                     .suffix("°"),
             );
@@ -962,7 +971,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
                  opened or slid (Shi's rule): once broken a joint keeps only friction.",
             );
             ui.add(
-                egui::Slider::new(&mut e.joint.cohesion, 0.0..=1e8)
+                slider(&mut e.joint.cohesion, 0.0..=1e8)
                     .logarithmic(true)
                     .smallest_positive(1e2)
                     .custom_formatter(|v, _| num(v))
@@ -979,7 +988,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
                  is redone with a smaller Δt. It also sets d_n,max = 2·δ·w0 (P22). Paper: 0.01.",
             );
             ui.add(
-                egui::Slider::new(&mut e.max_displacement_ratio, 1e-4..=0.1)
+                slider(&mut e.max_displacement_ratio, 1e-4..=0.1)
                     .logarithmic(true)
                     .custom_formatter(|v, _| num(v)),
             );
@@ -995,7 +1004,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
                  or open–close does not converge, and grow back by ≤ 1.3× per step. Paper: 0.01 s.",
             );
             ui.add(
-                egui::Slider::new(&mut e.max_time_step, 1e-5..=0.1)
+                slider(&mut e.max_time_step, 1e-5..=0.1)
                     .logarithmic(true)
                     .custom_formatter(|v, _| num(v))
                     .suffix(" s"),
@@ -1011,6 +1020,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
             ui.add(
                 egui::DragValue::new(&mut e.duration)
                     .range(1e-3..=1e6)
+                    .clamp_existing_to_range(false)
                     .speed(0.05)
                     .suffix(" s"),
             );
@@ -1032,7 +1042,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
                          give p_τ; Shi's code uses p_n / 2.5.",
                     );
                     ui.add(
-                        egui::Slider::new(&mut e.contact.shear_penalty_ratio, 0.01..=10.0)
+                        slider(&mut e.contact.shear_penalty_ratio, 0.01..=10.0)
                             .logarithmic(true)
                             .custom_formatter(|v, _| num(v)),
                     );
@@ -1043,20 +1053,14 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
                         "Cap on ALM iterations per open–close pass (the paper's loop has none; \
                          20 is the reference notes' suggestion).",
                     );
-                    ui.add(egui::Slider::new(
-                        &mut e.contact.max_alm_iterations,
-                        1..=100,
-                    ));
+                    ui.add(slider(&mut e.contact.max_alm_iterations, 1..=100));
                     ui.end_row();
                     param_label(
                         ui,
                         "Open–close passes",
                         "Open–close passes before the step is redone with 0.3·Δt (Shi: 6 + 2).",
                     );
-                    ui.add(egui::Slider::new(
-                        &mut e.contact.max_open_close_iterations,
-                        1..=50,
-                    ));
+                    ui.add(slider(&mut e.contact.max_open_close_iterations, 1..=50));
                     ui.end_row();
                     param_label(
                         ui,
@@ -1143,7 +1147,7 @@ fn display_section(ui: &mut egui::Ui, state: &mut UiState) {
                 }
             } else {
                 ui.add(
-                    egui::Slider::new(&mut d.force_scale, 1.0..=1e10)
+                    slider(&mut d.force_scale, 1.0..=1e10)
                         .logarithmic(true)
                         .custom_formatter(|v, _| format_force(v))
                         .text("per m"),
@@ -1794,6 +1798,121 @@ mod tests {
             penalty_mean: f64::NAN,
             penalty_max: f64::NAN,
         }
+    }
+
+    /// The rockfall after `steps` steps, as the panel sees it.
+    fn rockfall_state(steps: usize) -> (UiState, Frame) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join("rock_column_rockfall.toml");
+        let scene = crate::scene::load(&path).unwrap();
+        let mut solver = crate::solver::Solver::new(scene.model.clone(), scene.params.clone());
+        for _ in 0..steps {
+            solver.step().unwrap();
+        }
+        let snap = solver.snapshot();
+        let state = UiState::new(&scene, &snap, "test".into());
+        let frame = Frame {
+            seq: 1,
+            applied: 0,
+            generation: 0,
+            snapshot: Arc::new(snap),
+            params: solver.params.clone(),
+            state: RunState::Paused,
+            speed: Speed::Max,
+            error: None,
+            steps_per_second: 0.0,
+            seconds_per_step: 0.0,
+            running_seconds: 0.0,
+            totals: solver.totals.clone(),
+            max_step_penetration: solver.max_step_penetration(),
+        };
+        (state, frame)
+    }
+
+    #[test]
+    fn display_options_shape_the_scene() {
+        let (mut st, frame) = rockfall_state(3);
+        assert!(
+            !frame.snapshot.contacts.is_empty(),
+            "the column rests on contacts"
+        );
+        st.update(Some(Arc::new(frame)), &mut Vec::new());
+        st.build_scene();
+        let full = st.scene.clone().unwrap();
+        assert!(!full.solids.is_empty() && !full.arrows.is_empty());
+        let scale = full.force_scale.expect("force arrows have a scale");
+
+        st.display.wireframe = true;
+        st.build_scene();
+        let wire = st.scene.clone().unwrap();
+        assert!(wire.solids.is_empty(), "wireframe draws no faces");
+        assert!(wire.lines.len() >= full.lines.len(), "but all the edges");
+
+        st.display.wireframe = false;
+        st.display.forces = false;
+        st.build_scene();
+        assert!(st.scene.as_ref().unwrap().arrows.is_empty(), "no arrows");
+        st.display.normals = true;
+        st.build_scene();
+        assert!(
+            !st.scene.as_ref().unwrap().arrows.is_empty(),
+            "normal glyphs"
+        );
+
+        // The automatic arrow scale is fixed by the first frame with contacts.
+        st.display.forces = true;
+        st.build_scene();
+        assert_eq!(st.scene.as_ref().unwrap().force_scale, Some(scale));
+        st.display.auto_force_scale = false;
+        st.display.force_scale = 1234.0;
+        st.build_scene();
+        assert_eq!(st.scene.as_ref().unwrap().force_scale, Some(1234.0));
+    }
+
+    #[test]
+    fn stale_frames_do_not_overwrite_an_edit_in_flight() {
+        let (mut st, frame) = rockfall_state(0);
+        st.update(Some(Arc::new(frame.clone())), &mut Vec::new());
+        st.edit.contact.alpha = 5.0;
+        let sent = st.param_change().expect("an edit to send");
+        assert_eq!(sent.contact.alpha, 5.0);
+        assert!(st.param_change().is_none(), "sent once");
+        st.params_sent(7);
+        // A frame published before the sim thread took command 7 still has α = 10.
+        let stale = Frame {
+            applied: 6,
+            seq: 2,
+            ..frame.clone()
+        };
+        st.update(Some(Arc::new(stale)), &mut Vec::new());
+        assert_eq!(st.edit.contact.alpha, 5.0, "the widget keeps the edit");
+        let mut fresh = Frame {
+            applied: 7,
+            seq: 3,
+            ..frame
+        };
+        fresh.params.contact.alpha = 5.0;
+        fresh.params.duration = 4.0; // changed by the sim thread (play past the end)
+        st.update(Some(Arc::new(fresh)), &mut Vec::new());
+        assert_eq!(st.edit.duration, 4.0, "the widgets follow the solver again");
+        assert!(st.param_change().is_none(), "nothing to send back");
+    }
+
+    #[test]
+    fn records_of_an_old_run_are_dropped_on_reset() {
+        let (mut st, frame) = rockfall_state(0);
+        let mut recs: Vec<StepRecord> = (1..=3).map(|k| rec(k, 0.0)).collect();
+        st.update(Some(Arc::new(frame.clone())), &mut recs);
+        assert_eq!(st.history.records.len(), 3);
+        assert!(recs.is_empty(), "drained");
+        let reset = Frame {
+            generation: 1,
+            ..frame
+        };
+        let mut old = vec![rec(4, 0.0)]; // generation 0, arrived late
+        st.update(Some(Arc::new(reset)), &mut old);
+        assert!(st.history.records.is_empty());
     }
 
     #[test]

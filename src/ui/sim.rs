@@ -131,6 +131,9 @@ struct Mailbox {
     unread: bool,
 }
 
+/// Prefix of the message for a SetParams that failed validation.
+const REJECTED: &str = "parameters not applied";
+
 /// Records kept in the mailbox when the window does not drain them (minimised for hours).
 const MAILBOX_RECORD_CAP: usize = 200_000;
 /// Publications while running are at most this often: enough for any display, and cheap
@@ -477,17 +480,24 @@ impl Sim {
             }
             Command::SetParams(p) => match p.validate() {
                 Ok(()) => {
-                    let old_end = self.solver.params.duration;
                     self.solver.params = *p;
-                    if self.solver.params.duration != old_end && !self.solver.finished() {
-                        // A later end time re-opens a finished run.
-                        if self.state == RunState::Finished {
-                            self.state = RunState::Paused;
-                        }
+                    // The end time may have moved past or before the current time.
+                    match (&self.state, self.solver.finished()) {
+                        (RunState::Finished, false) => self.state = RunState::Paused,
+                        (RunState::Running, true) => self.state = RunState::Finished,
+                        _ => {}
                     }
-                    self.error = None;
+                    // A solver error stays up (it explains the failed state) until the run
+                    // is retried or reset; only a previous rejection is cleared.
+                    if self
+                        .error
+                        .as_deref()
+                        .is_some_and(|e| e.starts_with(REJECTED))
+                    {
+                        self.error = None;
+                    }
                 }
-                Err(m) => self.error = Some(format!("parameters not applied: {m}")),
+                Err(m) => self.error = Some(format!("{REJECTED}: {m}")),
             },
             Command::SetSpeed(s) => {
                 self.speed = s;
@@ -750,6 +760,29 @@ mod tests {
             f.params.duration
         );
         h.send(Command::Pause);
+    }
+
+    #[test]
+    fn solver_error_is_published_and_reset_recovers() {
+        let mut h = spawn(Speed::Max, false);
+        let mut p = h.latest().unwrap().params.clone();
+        // A penalty far too soft: the column sinks into its base until the solver gives up.
+        p.method = Method::Penalty;
+        p.contact.initial_penalty = 2.0e3;
+        h.send(Command::SetParams(Box::new(p)));
+        let id = h.send(Command::Play);
+        let f = h
+            .wait_for(WAIT, |f| f.applied >= id && f.state == RunState::Failed)
+            .expect("the run fails");
+        let msg = f.error.as_deref().expect("an error message");
+        assert!(msg.contains("diverged"), "{msg}");
+        assert!(h.is_alive(), "the thread survives a solver error");
+
+        let id = h.send(Command::Reset);
+        let f = h.wait_for(WAIT, |f| f.applied >= id).unwrap();
+        assert_eq!(f.snapshot.step, 0);
+        assert_eq!(f.state, RunState::Paused);
+        assert!(f.error.is_none());
     }
 
     #[test]
