@@ -5,6 +5,7 @@ fn main() {
     let cli = Cli::parse();
     let result = match &cli.command {
         Command::Run(args) => cli::run(args),
+        Command::Render(args) => cli::render(args),
         Command::Generate(args) => cli::generate(args),
         Command::Bench(args) => cli::bench(args),
     };
