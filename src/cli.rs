@@ -341,16 +341,27 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
 /// overlap with the simulation. Frames come from the solver's own steps, which are shortened to
 /// land exactly on the frame times, not from re-simulation.
 pub fn render(args: &RenderArgs) -> Result<(), CliError> {
-    use crate::render::{ArrowMode, CameraOverride, CaptureOptions, Coloring, FrameCapture, Framing, RenderError};
+    use crate::render::{
+        ArrowMode, CameraOverride, CaptureOptions, Coloring, FrameCapture, Framing, RenderError,
+    };
     let scene = load_scene(&args.scene, &args.overrides)?;
     if !(args.fps.is_finite() && args.fps > 0.0) {
-        return Err(CliError::Input(format!("--fps must be positive, got {}", args.fps)));
+        return Err(CliError::Input(format!(
+            "--fps must be positive, got {}",
+            args.fps
+        )));
     }
     if args.width == 0 || args.height == 0 || args.width > 16384 || args.height > 16384 {
-        return Err(CliError::Input(format!("--width/--height must lie in 1..=16384, got {}x{}", args.width, args.height)));
+        return Err(CliError::Input(format!(
+            "--width/--height must lie in 1..=16384, got {}x{}",
+            args.width, args.height
+        )));
     }
     if args.msaa != 1 && args.msaa != 4 {
-        return Err(CliError::Input(format!("--msaa must be 1 or 4, got {}", args.msaa)));
+        return Err(CliError::Input(format!(
+            "--msaa must be 1 or 4, got {}",
+            args.msaa
+        )));
     }
     let out = args
         .out
@@ -363,12 +374,16 @@ pub fn render(args: &RenderArgs) -> Result<(), CliError> {
     opts.gif = args.gif;
     opts.max_msaa_samples = args.msaa;
     if let Some(c) = &args.camera {
-        opts.camera = CameraOverride::parse(c).map_err(|e| CliError::Input(format!("--camera: {e}")))?;
+        opts.camera =
+            CameraOverride::parse(c).map_err(|e| CliError::Input(format!("--camera: {e}")))?;
     }
-    opts.style.coloring = Coloring::parse(&args.color).map_err(|e| CliError::Input(format!("--color: {e}")))?;
+    opts.style.coloring =
+        Coloring::parse(&args.color).map_err(|e| CliError::Input(format!("--color: {e}")))?;
     if let Some(f) = args.force_scale {
         if !(f.is_finite() && f > 0.0) {
-            return Err(CliError::Input(format!("--force-scale must be positive, got {f}")));
+            return Err(CliError::Input(format!(
+                "--force-scale must be positive, got {f}"
+            )));
         }
         opts.style.force_scale = Some(f);
     }
@@ -427,8 +442,11 @@ pub fn render(args: &RenderArgs) -> Result<(), CliError> {
         "setup_seconds": report.setup_seconds,
         "status": if failure.is_some() { "diverged" } else { "completed" },
     });
-    std::fs::write(out.join("render_summary.json"), serde_json::to_string_pretty(&summary).unwrap_or_default())
-        .map_err(|e| CliError::Run(format!("{}: {e}", out.display())))?;
+    std::fs::write(
+        out.join("render_summary.json"),
+        serde_json::to_string_pretty(&summary).unwrap_or_default(),
+    )
+    .map_err(|e| CliError::Run(format!("{}: {e}", out.display())))?;
     if let Some(e) = failure {
         return Err(CliError::Run(format!(
             "{}: {e}; {} frames up to t = {:.6} s are in {}",
