@@ -872,7 +872,8 @@ impl Solver {
                                 c.rec.intact = false;
                                 changed = true;
                             }
-                        } else if c.slip.dot(&c.rec.tau) < -state_tol {
+                        } else if c.slip.dot(&c.rec.tau) < -state_tol || c.slip.norm() < state_tol {
+                            // The slip reversed, or stopped: the contact sticks again.
                             c.rec.state = ContactState::Lock;
                             c.rec.reference = c.cand.xb;
                             changed = true;
