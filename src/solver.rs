@@ -615,6 +615,81 @@ impl Solver {
         }
     }
 
+    /// (K0, F0): the block terms of §3 for a step of length `dt`, fixed for an attempt.
+    fn block_terms(&self, dt: f64) -> (Vec<Mat12>, Vec<Vec12>) {
+        let p = &self.params;
+        let g = Vec3::from(p.gravity);
+        let mut k0 = Vec::with_capacity(self.model.blocks.len());
+        let mut f0 = Vec::with_capacity(self.model.blocks.len());
+        for b in &self.model.blocks {
+            let springs: Vec<(Vec3, Vec3, f64)> = if b.fixed {
+                let k = p.fixed_spring_factor * b.material.young_modulus;
+                b.vertices
+                    .iter()
+                    .zip(&b.anchors)
+                    .map(|(x, a)| (*x, *a, k))
+                    .collect()
+            } else {
+                Vec::new()
+            };
+            let terms = block_terms(
+                &BlockStepInput {
+                    mass_matrix: &b.mass_matrix,
+                    mp: &b.mp,
+                    density: b.density,
+                    elasticity: &b.elasticity,
+                    stress: &b.stress,
+                    velocity: &b.velocity,
+                    gravity: &g,
+                    loads: &b.loads,
+                    springs: &springs,
+                },
+                dt,
+            );
+            k0.push(terms.k);
+            f0.push(terms.f);
+        }
+        (k0, f0)
+    }
+
+    /// The stiffness (when `with_k`) and force terms of one closed contact in its current state:
+    /// normal (P10), locked shear spring (P15)/(5.7), or sliding friction (P20).
+    fn contact_terms(&self, c: &Active, with_k: bool) -> ContactTerms {
+        let p = &self.params;
+        let cp = &p.contact;
+        let mut t = ContactTerms::zero();
+        if with_k {
+            add_normal_stiffness(&mut t, &c.kin, c.rec.penalty);
+        }
+        let alm = p.method == Method::Alm;
+        add_normal_force(
+            &mut t,
+            &c.kin,
+            c.rec.penalty,
+            if alm { c.rec.lambda } else { 0.0 },
+        );
+        let tb = c.tb(&self.model.blocks);
+        match c.rec.state {
+            ContactState::Lock => {
+                let delta = c.cand.xa - c.rec.reference;
+                let p_tau = cp.shear_penalty_ratio * c.rec.penalty;
+                add_shear_spring(&mut t, &c.ta, &tb, &c.cand.normal, &delta, p_tau, with_k);
+            }
+            ContactState::Slide => {
+                // Friction from the previous iterate's normal force: λ_{k−1} (ALM), p_n d_n (penalty).
+                let n_prev = if alm {
+                    c.rec.lambda
+                } else {
+                    c.rec.normal_force.max(0.0)
+                };
+                let tan_phi = p.joint.friction_angle.to_radians().tan();
+                add_friction(&mut t, &c.ta, &tb, &c.rec.tau, n_prev * tan_phi);
+            }
+            ContactState::Open => {}
+        }
+        t
+    }
+
     fn iterate(
         &mut self,
         active: &mut [Active],
@@ -627,39 +702,8 @@ impl Solver {
         let cp = &p.contact;
         let nb = self.model.blocks.len();
         let t_asm = Instant::now();
-        let g = Vec3::from(p.gravity);
         // (K0, F0): the block terms of §3, fixed for the attempt.
-        let mut k0: Vec<Mat12> = Vec::with_capacity(nb);
-        let mut f0: Vec<Vec12> = Vec::with_capacity(nb);
-        for b in &self.model.blocks {
-            let springs: Vec<(Vec3, Vec3, f64)> = if b.fixed {
-                let k = p.fixed_spring_factor * b.material.young_modulus;
-                b.vertices
-                    .iter()
-                    .zip(&b.anchors)
-                    .map(|(x, a)| (*x, *a, k))
-                    .collect()
-            } else {
-                Vec::new()
-            };
-            let loads: Vec<(Vec3, Vec3)> = b.loads.clone();
-            let terms = block_terms(
-                &BlockStepInput {
-                    mass_matrix: &b.mass_matrix,
-                    mp: &b.mp,
-                    density: b.density,
-                    elasticity: &b.elasticity,
-                    stress: &b.stress,
-                    velocity: &b.velocity,
-                    gravity: &g,
-                    loads: &loads,
-                    springs: &springs,
-                },
-                dt,
-            );
-            k0.push(terms.k);
-            f0.push(terms.f);
-        }
+        let (k0, f0) = self.block_terms(dt);
         let mut timings = Duration::ZERO;
         timings += t_asm.elapsed();
 
@@ -693,40 +737,7 @@ impl Solver {
                     if c.rec.state == ContactState::Open {
                         continue;
                     }
-                    let mut t = ContactTerms::zero();
-                    if k_dirty {
-                        add_normal_stiffness(&mut t, &c.kin, c.rec.penalty);
-                    }
-                    let lambda = if p.method == Method::Alm {
-                        c.rec.lambda
-                    } else {
-                        0.0
-                    };
-                    add_normal_force(&mut t, &c.kin, c.rec.penalty, lambda);
-                    let tb = c.tb(&self.model.blocks);
-                    match c.rec.state {
-                        ContactState::Lock => {
-                            let delta = c.cand.xa - c.rec.reference;
-                            add_shear_spring(
-                                &mut t,
-                                &c.ta,
-                                &tb,
-                                &c.cand.normal,
-                                &delta,
-                                cp.shear_penalty_ratio * c.rec.penalty,
-                                k_dirty,
-                            );
-                        }
-                        ContactState::Slide => {
-                            let n_prev = if p.method == Method::Alm {
-                                c.rec.lambda
-                            } else {
-                                c.rec.normal_force.max(0.0)
-                            };
-                            add_friction(&mut t, &c.ta, &tb, &c.rec.tau, n_prev * tan_phi);
-                        }
-                        ContactState::Open => unreachable!(),
-                    }
+                    let t = self.contact_terms(c, k_dirty);
                     let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
                     if k_dirty {
                         kmat.diag[i] += t.k_ii;
@@ -1083,5 +1094,94 @@ fn assign_cohesion_areas(active: &mut [Active]) {
             active[k].rec.cohesion_area = area / idx.len() as f64;
             active[k].start.cohesion_area = area / idx.len() as f64;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::snapshot::ContactMode;
+
+    /// The assembled global matrix — block terms, fixed-point springs, and contacts in all three
+    /// closed configurations (normal + shear spring, normal + friction) of both entrance modes —
+    /// is symmetric and positive definite (reference §7), so Cholesky applies.
+    #[test]
+    fn assembled_matrix_is_symmetric_positive_definite() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes/rock_column_rockfall.toml");
+        let s = crate::scene::load(&path).unwrap();
+        let mut solver = Solver::new(s.model, s.params);
+        // Run into the impact, where vertex–face and edge–edge contacts are active.
+        while solver.time < 0.25 {
+            solver.step().unwrap();
+        }
+        let mut active = solver.activate();
+        assert!(
+            active
+                .iter()
+                .any(|c| c.cand.mode() == ContactMode::EdgeEdge)
+        );
+        assert!(
+            active
+                .iter()
+                .any(|c| c.cand.mode() == ContactMode::VertexFace)
+        );
+        let pairs: Vec<(usize, usize)> = active
+            .iter()
+            .map(|c| (c.cand.key.i as usize, c.cand.key.j as usize))
+            .collect();
+        let mut k = BlockMatrix::new(solver.model.blocks.len(), pairs);
+        // Alternate the states so that both closed variants are assembled; raise some penalties.
+        for (n, c) in active.iter_mut().enumerate() {
+            c.pair = k
+                .pair_index(c.cand.key.i as usize, c.cand.key.j as usize)
+                .unwrap();
+            c.rec.state = if n % 2 == 0 {
+                ContactState::Lock
+            } else {
+                ContactState::Slide
+            };
+            c.rec.penalty *= [1.0, 10.0, 100.0][n % 3];
+            c.rec.lambda = 1e4;
+            c.rec.tau = c
+                .cand
+                .normal
+                .cross(&Vec3::z())
+                .try_normalize(1e-9)
+                .unwrap_or(Vec3::x());
+        }
+        let (k0, _) = solver.block_terms(0.01);
+        k.diag.copy_from_slice(&k0);
+        for c in &active {
+            let t = solver.contact_terms(c, true);
+            let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
+            k.diag[i] += t.k_ii;
+            k.diag[j] += t.k_jj;
+            k.add_off(c.pair, i, j, &t.k_ij);
+        }
+        let n = 12 * solver.model.blocks.len();
+        let mut dense = nalgebra::DMatrix::<f64>::zeros(n, n);
+        for col in 0..n {
+            let mut e = vec![0.0; n];
+            e[col] = 1.0;
+            dense.set_column(col, &nalgebra::DVector::from_vec(k.mul(&e)));
+        }
+        let asym = (&dense - dense.transpose()).abs().max();
+        assert!(asym <= 1e-12 * dense.abs().max(), "asymmetry {asym:e}");
+        let eig = nalgebra::SymmetricEigen::new(dense.clone());
+        let min = eig.eigenvalues.min();
+        assert!(min > 0.0, "smallest eigenvalue {min:e}");
+        // And the sparse factorization agrees with the dense solve.
+        let mut chol = SparseCholesky::default();
+        chol.factorize(&k).unwrap();
+        let b: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        let mut x = b.clone();
+        chol.solve_in_place(&mut x);
+        let r: Vec<f64> = k.mul(&x).iter().zip(&b).map(|(a, b)| a - b).collect();
+        let rn = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        assert!(
+            rn < 1e-6 * b.iter().map(|v| v * v).sum::<f64>().sqrt(),
+            "residual {rn:e}"
+        );
     }
 }
