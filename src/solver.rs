@@ -183,6 +183,10 @@ struct Active {
     dn: f64,
     force: f64,
     dn_prev: Option<f64>,
+    /// State changes of this contact in the current attempt (to stop open–close cycles).
+    flips: u8,
+    /// Settled after cycling: no more state changes in this attempt.
+    frozen: bool,
     /// N(Δ + Δu_ab) of a locked contact after the last solve.
     shear: Vec3,
     /// Δu_ab projected on the tangent plane after the last solve.
@@ -231,9 +235,14 @@ pub struct RunTotals {
     pub unconverged_steps: u64,
     /// ALM loops that hit the iteration cap.
     pub alm_cap_hits: u64,
+    /// Contacts settled (open, or sliding) after cycling between states within one step.
+    pub frozen_contacts: u64,
     pub contacts_per_step: f64,
     pub timings: Timings,
 }
+
+/// State changes a contact may make in one attempt before it is settled (see `iterate`).
+const MAX_FLIPS: u8 = 2;
 
 enum Retry {
     OpenClose,
@@ -378,6 +387,15 @@ impl Solver {
                                 )));
                             }
                         }
+                    }
+                    if std::env::var_os("DDA3D_DEBUG_CUTS").is_some() {
+                        let why = match &reason {
+                            Retry::OpenClose => "open-close".to_string(),
+                            Retry::Displacement(r) => format!("displacement r={r:.2}"),
+                            Retry::Penetration(p) => format!("penetration {p:.2e}"),
+                            Retry::NotFinite => "not finite".to_string(),
+                        };
+                        eprintln!("cut at t={:.4} dt={dt:.2e}: {why}", self.time);
                     }
                     dt = match reason {
                         Retry::Displacement(r) => dt / r.sqrt() * 0.95,
@@ -576,6 +594,8 @@ impl Solver {
                     dn: 0.0,
                     force: 0.0,
                     dn_prev: None,
+                    flips: 0,
+                    frozen: false,
                     shear: Vec3::zeros(),
                     slip: Vec3::zeros(),
                 }
@@ -715,6 +735,10 @@ impl Solver {
         let mut oc_passes = 0u32;
         let mut solves = 0u32;
         let mut converged_states = false;
+        for c in active.iter_mut() {
+            c.flips = 0;
+            c.frozen = false;
+        }
         for _oc in 0..cp.max_open_close_iterations {
             oc_passes += 1;
             let mut k_dirty = true;
@@ -842,57 +866,89 @@ impl Solver {
                 let n = c.cand.normal;
                 let du = c.ta * di - tb * dj;
                 c.slip = du - n * n.dot(&du);
-                match c.rec.state {
-                    ContactState::Open => {
-                        if c.dn > close_tol {
-                            c.rec.state = ContactState::Lock;
-                            c.rec.reference = c.cand.xb;
-                            c.rec.lambda = 0.0;
-                            c.rec.penalty = cp.initial_penalty;
-                            c.rec.normal_force = 0.0;
-                            changed = true;
-                        }
-                    }
-                    ContactState::Lock | ContactState::Slide => {
-                        c.rec.normal_force = c.force;
-                        // Shi's opening test, a gap beyond f0·w0, as a force: tension beyond
-                        // p_n,1·f0·w0. The initial penalty, not the adapted one, so that a stiffened
-                        // contact cannot hold tension.
-                        if c.force < -cp.initial_penalty * state_tol {
-                            c.rec.state = ContactState::Open;
-                            c.rec.lambda = 0.0;
-                            c.rec.intact = false;
-                            changed = true;
-                            continue;
-                        }
-                        if c.rec.state == ContactState::Lock {
-                            let delta = c.cand.xa - c.rec.reference;
-                            let r = delta + du;
-                            c.shear = r - n * n.dot(&r);
-                            let shear = cp.shear_penalty_ratio * c.rec.penalty * c.shear.norm();
-                            let cohesion = if c.rec.intact {
-                                p.joint.cohesion * c.rec.cohesion_area
-                            } else {
-                                0.0
-                            };
-                            // Hysteresis: shear displacements below f0·w0 are not slip, so a
-                            // contact that carries no normal force does not flip lock ↔ slide.
-                            if c.shear.norm() > state_tol && shear > c.force * tan_phi + cohesion {
-                                c.rec.state = ContactState::Slide;
-                                c.rec.tau = c.shear.normalize();
-                                c.rec.intact = false;
+                if c.frozen {
+                    c.rec.normal_force = c.force;
+                    continue;
+                }
+                let before = c.rec.state;
+                'classify: {
+                    match c.rec.state {
+                        ContactState::Open => {
+                            if c.dn > close_tol {
+                                c.rec.state = ContactState::Lock;
+                                c.rec.reference = c.cand.xb;
+                                c.rec.lambda = 0.0;
+                                c.rec.penalty = cp.initial_penalty;
+                                c.rec.normal_force = 0.0;
                                 changed = true;
                             }
-                        } else if c.slip.dot(&c.rec.tau) < -state_tol || c.slip.norm() < state_tol {
-                            // The slip reversed, or stopped: the contact sticks again.
-                            c.rec.state = ContactState::Lock;
-                            c.rec.reference = c.cand.xb;
-                            changed = true;
-                        } else if c.slip.norm() > state_tol {
-                            // Friction follows the slip direction; it has not reversed here, so
-                            // friction along the old direction still did negative work.
-                            c.rec.tau = c.slip.normalize();
                         }
+                        ContactState::Lock | ContactState::Slide => {
+                            c.rec.normal_force = c.force;
+                            // Shi's opening test, a gap beyond f0·w0, as a force: tension beyond
+                            // p_n,1·f0·w0. The initial penalty, not the adapted one, so that a stiffened
+                            // contact cannot hold tension.
+                            if c.force < -cp.initial_penalty * state_tol {
+                                c.rec.state = ContactState::Open;
+                                c.rec.lambda = 0.0;
+                                c.rec.intact = false;
+                                changed = true;
+                                break 'classify;
+                            }
+                            if c.rec.state == ContactState::Lock {
+                                let delta = c.cand.xa - c.rec.reference;
+                                let r = delta + du;
+                                c.shear = r - n * n.dot(&r);
+                                let shear = cp.shear_penalty_ratio * c.rec.penalty * c.shear.norm();
+                                let cohesion = if c.rec.intact {
+                                    p.joint.cohesion * c.rec.cohesion_area
+                                } else {
+                                    0.0
+                                };
+                                // Hysteresis: shear displacements below f0·w0 are not slip, so a
+                                // contact that carries no normal force does not flip lock ↔ slide.
+                                if c.shear.norm() > state_tol
+                                    && shear > c.force * tan_phi + cohesion
+                                {
+                                    c.rec.state = ContactState::Slide;
+                                    c.rec.tau = c.shear.normalize();
+                                    c.rec.intact = false;
+                                    changed = true;
+                                }
+                            } else if c.slip.dot(&c.rec.tau) < -state_tol
+                                || c.slip.norm() < state_tol
+                            {
+                                // The slip reversed, or stopped: the contact sticks again.
+                                c.rec.state = ContactState::Lock;
+                                c.rec.reference = c.cand.xb;
+                                changed = true;
+                            } else if c.slip.norm() > state_tol {
+                                // Friction follows the slip direction; it has not reversed here, so
+                                // friction along the old direction still did negative work.
+                                c.rec.tau = c.slip.normalize();
+                            }
+                        }
+                    }
+                }
+                if c.rec.state != before {
+                    c.flips += 1;
+                    if c.flips > MAX_FLIPS {
+                        // A contact that keeps cycling (typically an edge–edge and a vertex–face
+                        // contact of one block pair taking the load in turn) is settled closed
+                        // and sliding for the rest of the attempt: closed so that nothing passes
+                        // through it, sliding so that it cannot stop a slip.
+                        {
+                            c.rec.state = ContactState::Slide;
+                            if c.slip.norm() > 0.0 {
+                                c.rec.tau = c.slip.normalize();
+                            } else if c.shear.norm() > 0.0 {
+                                c.rec.tau = c.shear.normalize();
+                            }
+                        }
+                        self.totals.frozen_contacts += (before != c.rec.state) as u64;
+                        changed |= before != c.rec.state;
+                        c.flips = 0;
+                        c.frozen = true;
                     }
                 }
             }
