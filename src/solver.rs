@@ -241,6 +241,9 @@ pub struct RunTotals {
     pub timings: Timings,
 }
 
+/// Penetrations below this fraction of the ALM tolerance ε1·d_n,max do not raise the penalty.
+const PENALTY_FLOOR: f64 = 0.01;
+
 /// State changes a contact may make in one attempt before it is settled (see `iterate`).
 const MAX_FLIPS: u8 = 2;
 
@@ -834,12 +837,22 @@ impl Solver {
                     // (P1): λ_k = λ_{k−1} + p_n d_n, kept non-negative.
                     c.rec.lambda = c.force.max(0.0);
                     // (P21): raise the penalty where the penetration does not fall fast enough.
+                    // Not for a contact whose penetration is already negligible against the
+                    // tolerance ε1·d_n,max: there the ratio test only sees round-off, and over
+                    // many steps it ratcheted every penalty of a standing wall up to γE, a
+                    // stiffness that turned a 4 µm motion into meganewtons at the next impact.
                     if let Some(prev) = c.dn_prev
                         && !(conv1 && conv2)
                         && c.dn.abs() > cp.beta * prev.abs()
+                        && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * dn_max
                     {
                         let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
                         if capped > c.rec.penalty {
+                            // Keep the shear spring's force as its stiffness (p_τ ∝ p_n) grows:
+                            // shorten the spring instead, so that no energy is created.
+                            let shrink = c.rec.penalty / capped;
+                            let delta = c.cand.xa - c.rec.reference;
+                            c.rec.reference = c.cand.xa - delta * shrink;
                             c.rec.penalty = capped;
                             k_dirty = true;
                         }
