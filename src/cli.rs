@@ -112,6 +112,9 @@ pub struct BenchArgs {
     /// Runs per measurement; the fastest is reported.
     #[arg(long, default_value_t = 3)]
     pub repeat: usize,
+    /// Simulated time of the scaling runs, s.
+    #[arg(long, default_value_t = 2.0)]
+    pub scaling_duration: f64,
 }
 
 /// Overrides of the scene's `[solver]` table, shared by the commands that simulate.
@@ -333,7 +336,13 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
             args.scene.display()
         )));
     }
-    crate::bench::run(&args.scene, &args.sizes, args.repeat).map_err(CliError::Run)
+    if !(args.scaling_duration.is_finite() && args.scaling_duration > 0.0) {
+        return Err(CliError::Input(
+            "--scaling-duration must be positive".into(),
+        ));
+    }
+    crate::bench::run(&args.scene, &args.sizes, args.repeat, args.scaling_duration)
+        .map_err(CliError::Run)
 }
 
 /// `dda3d render`: the solver runs on this thread and hands a snapshot to the capture pipeline
