@@ -264,6 +264,8 @@ pub struct Solver {
     /// Half the largest extent of the initial model (Shi's w0).
     w0: f64,
     records: HashMap<ContactKey, Record>,
+    /// Block pairs of the last step's sparsity pattern (a < b).
+    pattern: Vec<(usize, usize)>,
     chol: SparseCholesky,
     contacts: Vec<ContactSnapshot>,
     pub last: StepStats,
@@ -288,6 +290,7 @@ impl Solver {
             step: 0,
             w0,
             records: HashMap::new(),
+            pattern: Vec::new(),
             chol: SparseCholesky::default(),
             contacts: Vec::new(),
             last: StepStats::default(),
@@ -329,16 +332,29 @@ impl Solver {
                 b.velocity = Vec12::zeros();
             }
         }
-        let mut active = self.activate();
+        let (mut active, near) = self.activate();
+        // The sparsity pattern: block pairs with a contact now, plus pairs of the last pattern
+        // that are still near each other. Keeping those (as zero blocks) makes the pattern, and
+        // with it the symbolic analysis, stable while contacts come and go between neighbours.
         let pairs: Vec<(usize, usize)> = {
             let mut p: Vec<(usize, usize)> = active
                 .iter()
-                .map(|c| (c.cand.key.i as usize, c.cand.key.j as usize))
+                .map(|c| {
+                    let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
+                    (i.min(j), i.max(j))
+                })
+                .chain(
+                    self.pattern
+                        .iter()
+                        .copied()
+                        .filter(|q| near.binary_search(q).is_ok()),
+                )
                 .collect();
             p.sort_unstable();
             p.dedup();
             p
         };
+        self.pattern = pairs.clone();
         let mut kmat = BlockMatrix::new(self.model.blocks.len(), pairs);
         for c in &mut active {
             c.pair = kmat
@@ -506,15 +522,16 @@ impl Solver {
 
     /// Detects this step's contacts and attaches each to its record from the last step, or to a
     /// new one (reference §4.5).
-    fn activate(&mut self) -> Vec<Active> {
+    fn activate(&mut self) -> (Vec<Active>, Vec<(usize, usize)>) {
         let dp = self.detection_params();
         let blocks = &self.model.blocks;
         let shapes: Vec<Shape> = blocks.iter().map(Block::shape).collect();
         let pairs = broad_phase(&shapes, dp.search_distance);
+        let near = pairs.clone();
         let records = &self.records;
         let known = |k: &ContactKey| records.contains_key(k);
         let mut cands: Vec<Candidate> = Vec::new();
-        for (a, b) in pairs {
+        for &(a, b) in &pairs {
             cands.extend(detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known));
         }
         // Contact transfer: a vertex that slid onto an adjacent, almost coplanar face of the same
@@ -607,7 +624,7 @@ impl Solver {
         if first_step && p.joint.cohesion > 0.0 {
             assign_cohesion_areas(&mut active);
         }
-        active
+        (active, near)
     }
 
     /// One attempt at the step with length `dt`: the open–close loop around the ALM loop.
@@ -1184,7 +1201,7 @@ mod tests {
         while solver.time < 0.25 {
             solver.step().unwrap();
         }
-        let mut active = solver.activate();
+        let (mut active, _) = solver.activate();
         assert!(
             active
                 .iter()
