@@ -53,6 +53,9 @@ pub struct RenderArgs {
     /// Camera azimuth and elevation in degrees, and optionally distance in m: `az,el[,dist]`.
     #[arg(long, allow_hyphen_values = true)]
     pub camera: Option<String>,
+    /// Point the camera looks at, m: `x,y,z` (default: the centre of the framed box).
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', num_args = 3)]
+    pub target: Option<Vec<f64>>,
     /// Block colours: block (one colour per block), velocity, displacement.
     #[arg(long, default_value = "block")]
     pub color: String,
@@ -385,6 +388,14 @@ pub fn render(args: &RenderArgs) -> Result<(), CliError> {
     if let Some(c) = &args.camera {
         opts.camera =
             CameraOverride::parse(c).map_err(|e| CliError::Input(format!("--camera: {e}")))?;
+    }
+    if let Some(t) = &args.target {
+        if t.len() != 3 || t.iter().any(|v| !v.is_finite()) {
+            return Err(CliError::Input(
+                "--target needs three finite numbers x,y,z".into(),
+            ));
+        }
+        opts.camera.target = Some([t[0], t[1], t[2]]);
     }
     opts.style.coloring =
         Coloring::parse(&args.color).map_err(|e| CliError::Input(format!("--color: {e}")))?;

@@ -147,3 +147,22 @@ fn render_command_writes_the_requested_frames() {
         assert_eq!((img.width(), img.height()), (320, 180));
     }
 }
+
+/// With no adapter at all (no Vulkan driver visible), `render` says what to install and exits 2.
+#[test]
+fn render_without_an_adapter_is_an_input_error() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        .arg("render")
+        .arg(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope_stable.toml"))
+        .args(["--duration", "0.05", "--quiet", "--out"])
+        .arg(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_no_adapter"))
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("mesa-vulkan-drivers"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+}
