@@ -54,7 +54,7 @@ pub struct RenderArgs {
     #[arg(long, allow_hyphen_values = true)]
     pub camera: Option<String>,
     /// Point the camera looks at, m: `x,y,z` (default: the centre of the framed box).
-    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', num_args = 3)]
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', num_args = 1)]
     pub target: Option<Vec<f64>>,
     /// Block colours: block (one colour per block), velocity, displacement.
     #[arg(long, default_value = "block")]
