@@ -114,9 +114,27 @@ pub fn run(
     if sizes.is_empty() {
         return Ok(());
     }
+    for rock in [true, false] {
+        scaling_table(sizes, repeat, scaling_duration, rock)?;
+    }
+    Ok(())
+}
+
+/// One scaling table on generated walls, with or without the rockfall.
+fn scaling_table(sizes: &[usize], repeat: usize, duration: f64, rock: bool) -> Result<(), String> {
     println!(
-        "## Scaling: generated walls (`dda3d generate column --blocks N`), ALM, {scaling_duration} s simulated\n"
+        "\n## Scaling: generated walls (`dda3d generate column --blocks N{}`), ALM, {duration} s simulated\n",
+        if rock { "" } else { " --no-rock" }
     );
+    if rock {
+        println!(
+            "With the rockfall: the cost includes the open–close and ALM iterations of the impact.\n"
+        );
+    } else {
+        println!(
+            "Standing wall, no rock: the cost of detection, assembly and factorization alone.\n"
+        );
+    }
     println!(
         "| N blocks | steps | contacts/step | solves/step | factorizations/step | cuts | wall s | wall s per simulated s | µs per contact-step | ms per factorization |"
     );
@@ -124,10 +142,10 @@ pub fn run(
     let (mut ns, mut per_sim_s, mut walls, mut cs) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &n in sizes {
-        let text = column_wall(n, 5);
+        let text = column_wall(n, 5, rock);
         let mut s = scene::parse(&text, &format!("generated wall of {n}"), "wall")
             .map_err(|e| e.to_string())?;
-        s.params.duration = scaling_duration;
+        s.params.duration = duration;
         let r = best_of(&s, if n >= 1000 { 1 } else { repeat })
             .map_err(|e| format!("wall of {n}: {e}"))?;
         let t = &r.totals;

@@ -99,6 +99,9 @@ pub struct GenerateArgs {
     /// Blocks per column.
     #[arg(long, default_value_t = 5)]
     pub layers: usize,
+    /// Leave out the rock: a standing wall (to measure the cost of the machinery alone).
+    #[arg(long)]
+    pub no_rock: bool,
     /// Output scene file (default: out/column_<N>.toml).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -316,7 +319,9 @@ pub fn generate(args: &GenerateArgs) -> Result<(), CliError> {
         return Err(CliError::Input("--layers must be at least 1".into()));
     }
     let text = match args.kind {
-        GeneratedKind::Column => crate::generate::column_wall(args.blocks, args.layers),
+        GeneratedKind::Column => {
+            crate::generate::column_wall(args.blocks, args.layers, !args.no_rock)
+        }
     };
     let out = args
         .out
