@@ -57,7 +57,12 @@ pub fn growth_exponent(x: &[f64], y: &[f64]) -> f64 {
 }
 
 /// Prints the benchmark tables (Markdown).
-pub fn run(scene_path: &Path, sizes: &[usize], repeat: usize) -> Result<(), String> {
+pub fn run(
+    scene_path: &Path,
+    sizes: &[usize],
+    repeat: usize,
+    scaling_duration: f64,
+) -> Result<(), String> {
     let base = scene::load(scene_path).map_err(|e| e.to_string())?;
     println!(
         "## Rockfall ({}), {} s simulated, best of {repeat}\n",
@@ -109,43 +114,64 @@ pub fn run(scene_path: &Path, sizes: &[usize], repeat: usize) -> Result<(), Stri
     if sizes.is_empty() {
         return Ok(());
     }
+    for rock in [true, false] {
+        scaling_table(sizes, repeat, scaling_duration, rock)?;
+    }
+    Ok(())
+}
+
+/// One scaling table on generated walls, with or without the rockfall.
+fn scaling_table(sizes: &[usize], repeat: usize, duration: f64, rock: bool) -> Result<(), String> {
     println!(
-        "## Scaling: generated walls (`dda3d generate column --blocks N`), ALM, 2.0 s simulated\n"
+        "\n## Scaling: generated walls (`dda3d generate column --blocks N{}`), ALM, {duration} s simulated\n",
+        if rock { "" } else { " --no-rock" }
     );
+    if rock {
+        println!(
+            "With the rockfall: the cost includes the open–close and ALM iterations of the impact.\n"
+        );
+    } else {
+        println!(
+            "Standing wall, no rock: the cost of detection, assembly and factorization alone.\n"
+        );
+    }
     println!(
-        "| N blocks | steps | contacts/step | solves/step | wall s | wall s per simulated s | µs per contact-step |"
+        "| N blocks | steps | contacts/step | solves/step | factorizations/step | cuts | wall s | wall s per simulated s | µs per contact-step | ms per factorization |"
     );
-    println!("|---|---|---|---|---|---|---|");
-    let (mut ns, mut ws, mut cs) = (Vec::new(), Vec::new(), Vec::new());
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let (mut ns, mut per_sim_s, mut walls, mut cs) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &n in sizes {
-        let text = column_wall(n, 5);
-        let s = scene::parse(&text, &format!("generated wall of {n}"), "wall")
+        let text = column_wall(n, 5, rock);
+        let mut s = scene::parse(&text, &format!("generated wall of {n}"), "wall")
             .map_err(|e| e.to_string())?;
+        s.params.duration = duration;
         let r = best_of(&s, if n >= 1000 { 1 } else { repeat })
             .map_err(|e| format!("wall of {n}: {e}"))?;
         let t = &r.totals;
         let contact_steps = t.contacts_per_step * t.steps as f64;
         println!(
-            "| {n} | {} | {:.1} | {:.2} | {:.3} | {:.3} | {:.2} |",
+            "| {n} | {} | {:.1} | {:.2} | {:.2} | {} | {:.3} | {:.3} | {:.2} | {:.3} |",
             t.steps,
             t.contacts_per_step,
             t.alm_iterations as f64 / t.steps as f64,
+            t.factorizations as f64 / t.steps as f64,
+            t.time_step_cuts,
             r.wall,
             r.wall / r.simulated,
-            1e6 * r.wall / contact_steps
+            1e6 * r.wall / contact_steps,
+            1e3 * t.timings.factorization / t.factorizations.max(1) as f64
         );
         ns.push(n as f64);
-        ws.push(r.wall / r.simulated);
+        per_sim_s.push(r.wall / r.simulated);
+        walls.push(r.wall);
         cs.push(contact_steps);
     }
     if ns.len() >= 2 {
         println!(
-            "\nGrowth exponent of wall time per simulated second: {:.2} against N, {:.2} against contact-steps (1 = linear).",
-            growth_exponent(&ns, &ws),
-            growth_exponent(
-                &cs,
-                &ws.iter().zip(&ns).map(|(w, _)| *w).collect::<Vec<_>>()
-            )
+            "\nGrowth exponent (least squares on log-log, 1 = linear): wall time per simulated second against N: {:.2}; wall time against contact-steps: {:.2}.",
+            growth_exponent(&ns, &per_sim_s),
+            growth_exponent(&cs, &walls)
         );
     }
     Ok(())

@@ -26,12 +26,61 @@ pub struct Cli {
 pub enum Command {
     /// Simulate a scene without any window or GPU; write blocks.csv, contacts.csv, summary.json.
     Run(RunArgs),
+    /// Simulate headless and write PNG frames (and optionally an animated GIF) for reports.
+    Render(RenderArgs),
     /// Write a generated scene file (for measuring cost as the model grows).
     Generate(GenerateArgs),
     /// Time the rockfall scene with both methods, and the scaling on generated walls.
     Bench(BenchArgs),
     /// Open the interactive viewer (`dda3d SCENE.toml` is short for `dda3d view SCENE.toml`).
     View(crate::ui::ViewArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Output directory for frame_00000.png …, frames.csv (default: out/<scene name>/frames).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub overrides: SolverOverrides,
+    /// Frames per second of simulated time.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// Camera azimuth and elevation in degrees, and optionally distance in m: `az,el[,dist]`.
+    #[arg(long, allow_hyphen_values = true)]
+    pub camera: Option<String>,
+    /// Point the camera looks at, m: `x,y,z` (default: the centre of the framed box).
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', num_args = 1)]
+    pub target: Option<Vec<f64>>,
+    /// Block colours: block (one colour per block), velocity, displacement.
+    #[arg(long, default_value = "block")]
+    pub color: String,
+    /// Force arrow scale in N per metre of arrow (default: automatic, fixed after frame 0).
+    #[arg(long)]
+    pub force_scale: Option<f64>,
+    /// Draw contact normals as well as the force arrows.
+    #[arg(long)]
+    pub normals: bool,
+    /// Transparent background.
+    #[arg(long)]
+    pub transparent: bool,
+    /// Re-frame the camera on every frame instead of keeping the first frame's view.
+    #[arg(long)]
+    pub follow: bool,
+    /// Also write an animated GIF, animation.gif.
+    #[arg(long)]
+    pub gif: bool,
+    /// Antialiasing samples (1 or 4).
+    #[arg(long, default_value_t = 4)]
+    pub msaa: u32,
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 /// Kinds of generated scenes.
@@ -52,6 +101,9 @@ pub struct GenerateArgs {
     /// Blocks per column.
     #[arg(long, default_value_t = 5)]
     pub layers: usize,
+    /// Leave out the rock: a standing wall (to measure the cost of the machinery alone).
+    #[arg(long)]
+    pub no_rock: bool,
     /// Output scene file (default: out/column_<N>.toml).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -68,6 +120,9 @@ pub struct BenchArgs {
     /// Runs per measurement; the fastest is reported.
     #[arg(long, default_value_t = 3)]
     pub repeat: usize,
+    /// Simulated time of the scaling runs, s.
+    #[arg(long, default_value_t = 2.0)]
+    pub scaling_duration: f64,
 }
 
 /// Overrides of the scene's `[solver]` table, shared by the commands that simulate.
@@ -266,7 +321,9 @@ pub fn generate(args: &GenerateArgs) -> Result<(), CliError> {
         return Err(CliError::Input("--layers must be at least 1".into()));
     }
     let text = match args.kind {
-        GeneratedKind::Column => crate::generate::column_wall(args.blocks, args.layers),
+        GeneratedKind::Column => {
+            crate::generate::column_wall(args.blocks, args.layers, !args.no_rock)
+        }
     };
     let out = args
         .out
@@ -289,5 +346,155 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
             args.scene.display()
         )));
     }
-    crate::bench::run(&args.scene, &args.sizes, args.repeat).map_err(CliError::Run)
+    if !(args.scaling_duration.is_finite() && args.scaling_duration > 0.0) {
+        return Err(CliError::Input(
+            "--scaling-duration must be positive".into(),
+        ));
+    }
+    crate::bench::run(&args.scene, &args.sizes, args.repeat, args.scaling_duration)
+        .map_err(CliError::Run)
+}
+
+/// `dda3d render`: the solver runs on this thread and hands a snapshot to the capture pipeline
+/// (its own render thread and PNG encoder threads) at every frame time, so rendering and encoding
+/// overlap with the simulation. Frames come from the solver's own steps, which are shortened to
+/// land exactly on the frame times, not from re-simulation.
+pub fn render(args: &RenderArgs) -> Result<(), CliError> {
+    use crate::render::{
+        ArrowMode, CameraOverride, CaptureOptions, Coloring, FrameCapture, Framing, RenderError,
+    };
+    let scene = load_scene(&args.scene, &args.overrides)?;
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        return Err(CliError::Input(format!(
+            "--fps must be positive, got {}",
+            args.fps
+        )));
+    }
+    if args.width == 0 || args.height == 0 || args.width > 16384 || args.height > 16384 {
+        return Err(CliError::Input(format!(
+            "--width/--height must lie in 1..=16384, got {}x{}",
+            args.width, args.height
+        )));
+    }
+    if args.msaa != 1 && args.msaa != 4 {
+        return Err(CliError::Input(format!(
+            "--msaa must be 1 or 4, got {}",
+            args.msaa
+        )));
+    }
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)).join("frames"));
+    let mut opts = CaptureOptions::new(&out);
+    opts.width = args.width;
+    opts.height = args.height;
+    opts.fps = args.fps;
+    opts.gif = args.gif;
+    opts.max_msaa_samples = args.msaa;
+    if let Some(c) = &args.camera {
+        opts.camera =
+            CameraOverride::parse(c).map_err(|e| CliError::Input(format!("--camera: {e}")))?;
+    }
+    if let Some(t) = &args.target {
+        if t.len() != 3 || t.iter().any(|v| !v.is_finite()) {
+            return Err(CliError::Input(
+                "--target needs three finite numbers x,y,z".into(),
+            ));
+        }
+        opts.camera.target = Some([t[0], t[1], t[2]]);
+    }
+    opts.style.coloring =
+        Coloring::parse(&args.color).map_err(|e| CliError::Input(format!("--color: {e}")))?;
+    if let Some(f) = args.force_scale {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(CliError::Input(format!(
+                "--force-scale must be positive, got {f}"
+            )));
+        }
+        opts.style.force_scale = Some(f);
+    }
+    if args.normals {
+        opts.style.arrows = ArrowMode::Both;
+    }
+    opts.style.transparent = args.transparent;
+    if args.follow {
+        opts.framing = Framing::EachFrame;
+    }
+    let name = scene.name.clone();
+    let mut solver = Solver::new(scene.model, scene.params);
+    let capture = FrameCapture::start(opts).map_err(|e| match e {
+        RenderError::NoAdapter | RenderError::InvalidOptions(_) => CliError::Input(e.to_string()),
+        other => CliError::Run(other.to_string()),
+    })?;
+    let render_err = |e: RenderError| CliError::Run(format!("{}: {e}", out.display()));
+    let start = Instant::now();
+    let mut sim_seconds = 0.0;
+    let frame_dt = 1.0 / args.fps;
+    let total_frames = (solver.params.duration * args.fps + 1e-9).floor() as u64 + 1;
+    let mut progress = Progress::new(solver.params.duration, args.quiet);
+    capture.submit(solver.snapshot()).map_err(render_err)?;
+    let mut failure = None;
+    'frames: for k in 1..total_frames {
+        let t = k as f64 * frame_dt;
+        while solver.time < t - 1e-9 * frame_dt {
+            let ts = Instant::now();
+            let r = solver.step_until(t);
+            sim_seconds += ts.elapsed().as_secs_f64();
+            if let Err(e) = r {
+                failure = Some(e);
+                break 'frames;
+            }
+        }
+        capture.submit(solver.snapshot()).map_err(render_err)?;
+        progress.update(solver.time);
+    }
+    progress.finish();
+    let report = capture.finish().map_err(render_err)?;
+    let wall = start.elapsed().as_secs_f64();
+    let summary = serde_json::json!({
+        "scene": name,
+        "frames": report.frames,
+        "fps_of_simulated_time": args.fps,
+        "width": args.width,
+        "height": args.height,
+        "adapter": report.adapter,
+        "msaa_samples": report.msaa_samples,
+        "wall_seconds": wall,
+        "frames_per_wall_second": report.frames as f64 / wall,
+        "simulation_seconds": sim_seconds,
+        "render_seconds": report.render_seconds,
+        "png_encode_seconds": report.encode_seconds,
+        "gif_seconds": report.gif_seconds,
+        "setup_seconds": report.setup_seconds,
+        "status": if failure.is_some() { "diverged" } else { "completed" },
+    });
+    std::fs::write(
+        out.join("render_summary.json"),
+        serde_json::to_string_pretty(&summary).unwrap_or_default(),
+    )
+    .map_err(|e| CliError::Run(format!("{}: {e}", out.display())))?;
+    if let Some(e) = failure {
+        return Err(CliError::Run(format!(
+            "{}: {e}; {} frames up to t = {:.6} s are in {}",
+            args.scene.display(),
+            report.frames,
+            solver.time,
+            out.display()
+        )));
+    }
+    if !args.quiet {
+        eprintln!(
+            "{name}: {} frames in {:.2} s ({:.1} frames/s; simulation {:.2} s, render+readback {:.1} ms/frame, PNG {:.1} ms/frame on {}); frames in {}",
+            report.frames,
+            wall,
+            report.frames as f64 / wall,
+            sim_seconds,
+            report.render_ms_per_frame(),
+            report.encode_ms_per_frame(),
+            report.adapter,
+            out.display()
+        );
+    }
+    Ok(())
 }

@@ -11,7 +11,7 @@ use std::fmt::Write;
 /// δ is set so that δ·w0 = 0.05 m whatever the wall's length: Shi's control lengths (search
 /// distance, penetration tolerance) scale with w0, and on a 240 m wall the paper's δ = 0.01 would
 /// let a vertex move 1.2 m a step and search for contacts 3 m away, across neighbouring blocks.
-pub fn column_wall(blocks: usize, layers: usize) -> String {
+pub fn column_wall(blocks: usize, layers: usize, rock: bool) -> String {
     let layers = layers.clamp(1, blocks.max(1));
     let columns = blocks.div_ceil(layers);
     let (bx, by, bz) = (1.2, 1.2, 2.0);
@@ -72,6 +72,9 @@ pub fn column_wall(blocks: usize, layers: usize) -> String {
             );
         }
     }
+    if !rock {
+        return s;
+    }
     // The rock: aimed at the upper part of the middle column.
     let mid = y0 + ((columns / 2) as f64 + 0.5) * by;
     let zr = (height * 0.73).max(1.5);
@@ -92,10 +95,13 @@ mod tests {
     #[test]
     fn generated_walls_parse_with_the_requested_block_count() {
         for (n, layers) in [(5, 5), (12, 5), (100, 5), (1000, 5)] {
-            let text = column_wall(n, layers);
+            let text = column_wall(n, layers, true);
             let scene = crate::scene::parse(&text, "generated", "g").expect("valid scene");
             // n wall blocks + ground + rock.
             assert_eq!(scene.model.blocks.len(), n + 2);
+            let standing =
+                crate::scene::parse(&column_wall(n, layers, false), "generated", "g").unwrap();
+            assert_eq!(standing.model.blocks.len(), n + 1);
             assert_eq!(
                 scene.model.blocks.iter().filter(|b| b.fixed).count(),
                 n.div_ceil(layers) + 1

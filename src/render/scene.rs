@@ -322,7 +322,9 @@ impl Scene {
                 // The force on block i is +N·n (n points from j toward i); a tensile (negative)
                 // force points the other way.
                 let dir = if c.normal_force >= 0.0 { n } else { -n };
-                let len = (c.normal_force.abs() / scale) as f32;
+                // Impacts can carry a hundred times the static forces that set a fixed scale;
+                // cap the arrow at 40 % of the view so it does not cross the whole picture.
+                let len = ((c.normal_force.abs() / scale) as f32).min(0.4 * size as f32);
                 mesh::push_arrow(&mut arrows, &Arrow::new(base, dir, len, shaft), state_color);
             }
             if draw_normals {

@@ -1,0 +1,168 @@
+//! Renders the shipped slope scene (scenes/slope_stable.toml) through the solver: at t = 0, and
+//! after the first step, when its four contacts exist and carry the block's weight.
+
+mod render_support;
+
+use dda3d::render::capture::render_rgba;
+use dda3d::render::mesh::BLOCK_PALETTE_SRGB;
+use dda3d::render::scene::BACKGROUND_SRGB;
+use dda3d::render::{CaptureOptions, Offscreen};
+use dda3d::scene;
+use dda3d::solver::Solver;
+use render_support::*;
+
+const W: u32 = 1280;
+const H: u32 = 720;
+
+fn is_background(px: [u8; 4]) -> bool {
+    let bg = [
+        (BACKGROUND_SRGB >> 16) as u8,
+        (BACKGROUND_SRGB >> 8) as u8,
+        BACKGROUND_SRGB as u8,
+    ];
+    (0..3).all(|k| px[k].abs_diff(bg[k]) <= 1) && px[3] == 255
+}
+
+fn blue(img: &[u8]) -> usize {
+    img.chunks_exact(4)
+        .filter(|p| is_lock_blue([p[0], p[1], p[2], p[3]]))
+        .count()
+}
+
+#[test]
+fn shipped_slope_scene_renders_through_the_solver() {
+    let Some(gpu) = gpu_or_skip("shipped_slope_scene_renders_through_the_solver") else {
+        return;
+    };
+    let s = scene::load(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope_stable.toml"),
+    )
+    .unwrap();
+    let mut solver = Solver::new(s.model, s.params);
+    let snap0 = solver.snapshot();
+    assert_eq!(snap0.time, 0.0);
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_scene");
+    std::fs::create_dir_all(&dir).unwrap();
+    let opts = CaptureOptions::new(&dir);
+    let mut off = Offscreen::new(gpu, W, H).unwrap();
+    let (rgba0, camera) = render_rgba(&mut off, &snap0, &opts).unwrap();
+    assert_eq!(rgba0.len(), (W * H * 4) as usize, "requested size");
+    let non_bg = rgba0
+        .chunks_exact(4)
+        .filter(|p| !is_background([p[0], p[1], p[2], p[3]]))
+        .count();
+    assert!(
+        non_bg > (W * H / 10) as usize,
+        "not blank: {non_bg} drawn pixels"
+    );
+
+    // The block's centroid projected with the camera matrices lies on block-coloured pixels.
+    let block = snap0.blocks.iter().position(|b| b.name == "block").unwrap();
+    let c = camera
+        .project(snap0.blocks[block].centroid, W, H)
+        .expect("in front of the camera");
+    let mut hits = 0;
+    for dy in -2i32..=2 {
+        for dx in -2i32..=2 {
+            if same_hue(
+                pixel(
+                    &rgba0,
+                    W,
+                    (c.x as i32 + dx) as u32,
+                    (c.y as i32 + dy) as u32,
+                ),
+                BLOCK_PALETTE_SRGB[block],
+            ) {
+                hits += 1;
+            }
+        }
+    }
+    assert!(
+        hits >= 20,
+        "centroid {c:?}: {hits}/25 block-coloured pixels"
+    );
+    for (x, y) in [(W - 3, 3), (W / 2, 3)] {
+        assert!(
+            is_background(pixel(&rgba0, W, x, y)),
+            "({x},{y}) should be background"
+        );
+    }
+    // No contact has been computed at t = 0, so no arrows yet.
+    assert!(solver.contacts().is_empty());
+
+    // After one step the four base contacts carry the weight: force arrows appear.
+    solver.step().unwrap();
+    let snap1 = solver.snapshot();
+    assert_eq!(snap1.contacts.len(), 4);
+    let (rgba1, _) = render_rgba(&mut off, &snap1, &opts).unwrap();
+    let (with, without) = (blue(&rgba1), blue(&rgba0));
+    assert!(
+        with > without + 200,
+        "arrow pixels: {with} with contacts, {without} without"
+    );
+}
+
+/// `dda3d render` as a user runs it: N frame times requested, N files, increasing times.
+#[test]
+fn render_command_writes_the_requested_frames() {
+    if gpu_or_skip("render_command_writes_the_requested_frames").is_none() {
+        return;
+    }
+    let out = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_cmd");
+    let _ = std::fs::remove_dir_all(&out);
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope_sliding.toml");
+    let st = std::process::Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        .arg("render")
+        .arg(&scene)
+        .args([
+            "--duration",
+            "0.2",
+            "--fps",
+            "20",
+            "--width",
+            "320",
+            "--height",
+            "180",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&out)
+        .status()
+        .unwrap();
+    assert!(st.success());
+    let csv = std::fs::read_to_string(out.join("frames.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(lines.next(), Some("frame,time,step,file"));
+    let rows: Vec<Vec<String>> = lines
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    assert_eq!(rows.len(), 5, "t = 0, 0.05, 0.1, 0.15, 0.2");
+    let mut last = -1.0;
+    for (k, r) in rows.iter().enumerate() {
+        let t: f64 = r[1].parse().unwrap();
+        assert!(t > last, "times increase");
+        assert!((t - 0.05 * k as f64).abs() < 1e-9, "frame {k} at t = {t}");
+        last = t;
+        let img = image::open(out.join(&r[3])).unwrap();
+        assert_eq!((img.width(), img.height()), (320, 180));
+    }
+}
+
+/// With no adapter at all (no Vulkan driver visible), `render` says what to install and exits 2.
+#[test]
+fn render_without_an_adapter_is_an_input_error() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        .arg("render")
+        .arg(std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope_stable.toml"))
+        .args(["--duration", "0.05", "--quiet", "--out"])
+        .arg(std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_no_adapter"))
+        .env("WGPU_BACKEND", "vulkan")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("mesa-vulkan-drivers"), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+}
