@@ -46,6 +46,11 @@ pub struct Options {
     pub out_dir: PathBuf,
 }
 
+/// On a software rasterizer, drawing competes with the solver for the same cores: animation is
+/// capped at 40 frames/s there, which keeps the window above 30 frames/s while the solver gets the
+/// time between frames. GPUs are paced by vsync instead.
+const CPU_FRAME_INTERVAL: Duration = Duration::from_millis(25);
+
 /// Sent to the event loop to wake it (a new simulation frame, a background job done).
 #[derive(Debug, Clone, Copy)]
 struct Wake;
@@ -262,6 +267,8 @@ struct Viewer {
     recording: Option<Recording>,
     /// The steps/s of the last frame that had the solver running (for the exit report).
     last_steps_per_second: f64,
+    /// Animation frames are not started more often than this (software rasterizers only).
+    min_frame_interval: Option<Duration>,
 }
 
 struct Recording {
@@ -425,6 +432,7 @@ impl Viewer {
             proxy,
             recording: None,
             last_steps_per_second: 0.0,
+            min_frame_interval: cpu.then_some(CPU_FRAME_INTERVAL),
         })
     }
 
@@ -626,7 +634,12 @@ impl Viewer {
             .map(|v| v.repaint_delay)
             .unwrap_or(Duration::MAX);
         if busy || delay.is_zero() {
-            self.window.request_redraw();
+            match self.min_frame_interval {
+                // Input still redraws at once (winit events request a redraw); only the
+                // animation is paced, leaving the solver the rest of the CPU.
+                Some(min) if started.elapsed() < min => self.next_repaint = Some(started + min),
+                _ => self.window.request_redraw(),
+            }
         } else if delay < Duration::from_secs(3600) {
             self.next_repaint = Some(Instant::now() + delay);
         }

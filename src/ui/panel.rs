@@ -89,8 +89,10 @@ pub struct History {
 
 /// Steps kept for the plots; older ones are dropped (a long run keeps its recent past).
 const HISTORY_CAP: usize = 200_000;
-/// Points per plotted line: more would only cost tessellation time on a software rasterizer.
-const PLOT_POINTS: usize = 800;
+/// Points per plotted line: about one per pixel of a plot's width. Each point becomes several
+/// anti-aliased triangles, and on a software rasterizer triangles, not pixels, dominate the cost
+/// of the plots.
+const PLOT_POINTS: usize = 240;
 
 /// Frame-time bookkeeping for the toolbar and the benchmark line.
 #[derive(Default)]
