@@ -183,6 +183,8 @@ struct ViewTarget {
     view: wgpu::TextureView,
     id: egui::TextureId,
     size: (u32, u32),
+    /// (scene version, camera, size) of the picture in the texture.
+    drawn: Option<(u64, crate::render::Camera, (u32, u32))>,
 }
 
 /// The colour format of the view texture: non-sRGB like the window (the renderer then encodes
@@ -200,6 +202,7 @@ impl ViewTarget {
             view,
             id,
             size: (1, 1),
+            drawn: None,
         }
     }
 
@@ -238,6 +241,7 @@ impl ViewTarget {
         self.targets = targets;
         self.view = view;
         self.size = (w, h);
+        self.drawn = None;
     }
 }
 
@@ -539,17 +543,24 @@ impl Viewer {
             let mut camera = self.ui.view.camera.clone();
             camera.aspect = vw as f32 / vh as f32;
             let (w, h) = self.view.size;
-            match self
-                .view
-                .renderer
-                .prepare(device, queue, scene, &camera, w, h)
-            {
-                Ok(()) => {
-                    self.view
-                        .renderer
-                        .encode(&mut encoder, &self.view.targets, &self.view.view)
+            // The view texture keeps its picture: redraw only when something in it changed.
+            let key = (self.ui.scene_version, camera.clone(), (w, h));
+            if self.view.drawn.as_ref() != Some(&key) {
+                match self
+                    .view
+                    .renderer
+                    .prepare(device, queue, scene, &camera, w, h)
+                {
+                    Ok(()) => {
+                        self.view.renderer.encode(
+                            &mut encoder,
+                            &self.view.targets,
+                            &self.view.view,
+                        );
+                        self.view.drawn = Some(key);
+                    }
+                    Err(e) => self.ui.error(format!("cannot draw this step: {e}")),
                 }
-                Err(e) => self.ui.error(format!("cannot draw this step: {e}")),
             }
         }
 
@@ -651,7 +662,11 @@ impl Viewer {
         for a in actions {
             match a {
                 Action::Sim(cmd) => {
-                    self.sim.send(cmd);
+                    let shown = matches!(cmd, Command::SetSpeed(_));
+                    let id = self.sim.send(cmd);
+                    if shown {
+                        self.ui.params_sent(id);
+                    }
                 }
                 Action::Screenshot => self.screenshot_view(),
                 Action::ToggleRecord => self.toggle_record(),

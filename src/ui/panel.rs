@@ -181,6 +181,10 @@ pub struct UiState {
     pub scene_frame: SceneFrame,
     /// The scene drawn this frame (built in the UI pass, drawn by the app).
     pub scene: Option<Scene>,
+    /// Bumped whenever `scene` is rebuilt, so the app can skip redrawing an unchanged view.
+    pub scene_version: u64,
+    /// What `scene` was built from: (frame seq, style, wireframe).
+    scene_key: Option<(u64, SceneStyle, bool)>,
     locked_force_scale: Option<f64>,
     field_max: f64,
     /// The 3-D view's rectangle in points.
@@ -230,6 +234,8 @@ impl UiState {
             view: ViewControls::new(frame.lo, frame.hi, 16.0 / 9.0),
             scene_frame: frame,
             scene: None,
+            scene_version: 0,
+            scene_key: None,
             locked_force_scale: None,
             field_max: 0.0,
             view_rect: Rect::NOTHING,
@@ -294,7 +300,8 @@ impl UiState {
         Some(self.edit.clone())
     }
 
-    /// Call after the app sent a SetParams so stale frames do not reset the widgets.
+    /// Call after the app sent a SetParams or SetSpeed, so that frames published before the
+    /// sim thread took it do not reset the widgets.
     pub fn params_sent(&mut self, id: u64) {
         self.params_id = id;
     }
@@ -330,6 +337,10 @@ impl UiState {
             return;
         };
         let snap = &frame.snapshot;
+        let key = (frame.seq, self.style(), self.display.wireframe);
+        if self.scene.is_some() && self.scene_key.as_ref() == Some(&key) {
+            return; // same snapshot, same look: a large model is not rebuilt every frame
+        }
         if self.display.coloring != Coloring::PerBlock {
             // Grow-only colour range, so a colour means the same speed all run long.
             let m = snap
@@ -354,6 +365,10 @@ impl UiState {
                     scene.solids.clear();
                 }
                 self.scene = Some(scene);
+                self.scene_version += 1;
+                // Keyed on the style it was built with (before a new lock of the arrow scale),
+                // so the next frame rebuilds once with the locked scale and then settles.
+                self.scene_key = Some(key);
             }
             Err(e) => {
                 self.scene = None;
