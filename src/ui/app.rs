@@ -118,8 +118,8 @@ impl ApplicationHandler<Wake> for App {
     }
 
     fn user_event(&mut self, _el: &ActiveEventLoop, _event: Wake) {
-        if let Some(v) = &self.viewer {
-            v.window.request_redraw();
+        if let Some(v) = &mut self.viewer {
+            v.wake();
         }
     }
 
@@ -438,6 +438,18 @@ impl Viewer {
             last_steps_per_second: 0.0,
             min_frame_interval: cpu.then_some(CPU_FRAME_INTERVAL),
         })
+    }
+
+    /// A new simulation frame or a finished background job: draw it, but no sooner than the
+    /// frame cap allows.
+    fn wake(&mut self) {
+        match (self.min_frame_interval, self.ui.perf.last_start()) {
+            (Some(min), Some(last)) if last.elapsed() < min => {
+                let at = last + min;
+                self.next_repaint = Some(self.next_repaint.map_or(at, |t| t.min(at)));
+            }
+            _ => self.window.request_redraw(),
+        }
     }
 
     fn resize(&mut self, size: PhysicalSize<u32>) {

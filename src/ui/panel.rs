@@ -122,6 +122,11 @@ impl Perf {
         now
     }
 
+    /// When the last frame started.
+    pub fn last_start(&self) -> Option<Instant> {
+        self.last_start
+    }
+
     pub fn frame_done(&mut self, started: Instant) {
         let b = started.elapsed().as_secs_f64();
         self.busy.push_back(b);
@@ -488,7 +493,7 @@ pub fn build(ui: &mut egui::Ui, state: &mut UiState, view_texture: egui::Texture
                     .show(ui, |ui| run_section(ui, state));
             });
         });
-    egui::CentralPanel::no_frame().show(ui, |ui| view_3d(ui, state, view_texture, &mut actions));
+    egui::CentralPanel::no_frame().show(ui, |ui| view_3d(ui, state, view_texture));
     keyboard(ui, state, &mut actions);
     actions
 }
@@ -1568,12 +1573,7 @@ fn plots(ui: &mut egui::Ui, state: &mut UiState) {
 // ---------------------------------------------------------------------------------------------
 // 3-D view
 
-fn view_3d(
-    ui: &mut egui::Ui,
-    state: &mut UiState,
-    texture: egui::TextureId,
-    actions: &mut Vec<Action>,
-) {
+fn view_3d(ui: &mut egui::Ui, state: &mut UiState, texture: egui::TextureId) {
     let rect = ui.max_rect();
     state.view_rect = rect;
     state.view.set_viewport(rect.width(), rect.height());
@@ -1601,7 +1601,6 @@ fn view_3d(
         let p = pos - rect.min;
         state.selected = state.view.pick(&f.snapshot, p.x, p.y, w, h);
     }
-    let _ = actions;
 
     let painter = ui.painter_at(rect);
     painter.image(
