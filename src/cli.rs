@@ -113,10 +113,10 @@ pub struct BenchArgs {
     #[arg(long, default_value = "scenes/rock_column_rockfall.toml")]
     pub scene: PathBuf,
     /// Generated wall sizes for the scaling study with the rockfall (comma separated).
-    #[arg(long, value_delimiter = ',', default_value = "10,100")]
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "10,100")]
     pub sizes: Vec<usize>,
     /// Generated wall sizes for the scaling study of a standing wall (no rock).
-    #[arg(long, value_delimiter = ',', default_value = "10,100,1000")]
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "10,100,1000")]
     pub standing_sizes: Vec<usize>,
     /// Runs per measurement; the fastest is reported.
     #[arg(long, default_value_t = 3)]
