@@ -241,6 +241,12 @@ pub struct RunTotals {
     pub timings: Timings,
 }
 
+/// `DDA3D_DEBUG=1` logs every state change and every Δt cut to stderr (for tuning).
+fn debug_log() -> bool {
+    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ON.get_or_init(|| std::env::var_os("DDA3D_DEBUG").is_some_and(|v| v != "0"))
+}
+
 /// Penetrations below this fraction of the ALM tolerance ε1·d_n,max do not raise the penalty.
 const PENALTY_FLOOR: f64 = 0.01;
 
@@ -407,7 +413,7 @@ impl Solver {
                             }
                         }
                     }
-                    if std::env::var_os("DDA3D_DEBUG_CUTS").is_some() {
+                    if debug_log() {
                         let why = match &reason {
                             Retry::OpenClose => "open-close".to_string(),
                             Retry::Displacement(r) => format!("displacement r={r:.2}"),
@@ -960,6 +966,22 @@ impl Solver {
                         }
                     }
                 }
+                if c.rec.state != before && debug_log() {
+                    eprintln!(
+                        "t={:.4} dt={dt:.2e} pass {oc_passes}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} pair={}-{}",
+                        self.time,
+                        before,
+                        c.rec.state,
+                        c.cand.key.mode,
+                        c.force,
+                        c.dn,
+                        c.rec.penalty,
+                        c.shear.norm(),
+                        c.slip.norm(),
+                        c.cand.key.i,
+                        c.cand.key.j
+                    );
+                }
                 if c.rec.state != before {
                     c.flips += 1;
                     if c.flips > MAX_FLIPS {
@@ -983,24 +1005,6 @@ impl Solver {
                 }
             }
             timings += t2.elapsed();
-            if changed && std::env::var_os("DDA3D_DEBUG_OC").is_some() {
-                for c in active.iter() {
-                    if c.rec.state != c.start.state {
-                        eprintln!(
-                            "t={:.4} dt={dt:.2e} pass {oc_passes}: {:?} {:?}->{:?} dn={:.3e} N={:.3e} p={:.1e} shear={:.3e} slip={:.3e}",
-                            self.time,
-                            c.cand.key,
-                            c.start.state,
-                            c.rec.state,
-                            c.dn,
-                            c.force,
-                            c.rec.penalty,
-                            c.shear.norm(),
-                            c.slip.norm()
-                        );
-                    }
-                }
-            }
             if !changed {
                 converged_states = true;
                 break;

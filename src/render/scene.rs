@@ -498,8 +498,15 @@ mod tests {
         // A force far beyond the scale is capped at 40 % of the view.
         let big = snap(vec![contact(1e6, ContactState::Lock)]);
         let capped = Scene::build(&big, &style, &frame).unwrap();
-        let top_big = capped.arrows.iter().map(|v| v.position[2] - base.z).fold(f32::MIN, f32::max);
-        assert!((top_big - 0.4 * frame.size() as f32).abs() < 1e-3, "capped top {top_big}");
+        let top_big = capped
+            .arrows
+            .iter()
+            .map(|v| v.position[2] - base.z)
+            .fold(f32::MIN, f32::max);
+        assert!(
+            (top_big - 0.4 * frame.size() as f32).abs() < 1e-3,
+            "capped top {top_big}"
+        );
         assert_eq!(scene.contacts_lock, 1);
         let lock = srgb_to_linear(hex(LOCK_SRGB));
         assert!(scene.arrows.iter().all(|v| v.color == lock));
