@@ -718,7 +718,7 @@ impl Solver {
         match c.rec.state {
             ContactState::Lock => {
                 let delta = c.cand.xa - c.rec.reference;
-                let p_tau = cp.shear_penalty_ratio * c.rec.penalty;
+                let p_tau = cp.shear_penalty(c.rec.penalty);
                 add_shear_spring(&mut t, &c.ta, &tb, &c.cand.normal, &delta, p_tau, with_k);
             }
             ContactState::Slide => {
@@ -873,7 +873,7 @@ impl Solver {
                         if capped > c.rec.penalty {
                             // Keep the shear spring's force as its stiffness (p_τ ∝ p_n) grows:
                             // shorten the spring instead, so that no energy is created.
-                            let shrink = c.rec.penalty / capped;
+                            let shrink = cp.shear_penalty(c.rec.penalty) / cp.shear_penalty(capped);
                             let delta = c.cand.xa - c.rec.reference;
                             c.rec.reference = c.cand.xa - delta * shrink;
                             c.rec.penalty = capped;
@@ -935,7 +935,7 @@ impl Solver {
                                 let delta = c.cand.xa - c.rec.reference;
                                 let r = delta + du;
                                 c.shear = r - n * n.dot(&r);
-                                let shear = cp.shear_penalty_ratio * c.rec.penalty * c.shear.norm();
+                                let shear = cp.shear_penalty(c.rec.penalty) * c.shear.norm();
                                 let cohesion = if c.rec.intact {
                                     p.joint.cohesion * c.rec.cohesion_area
                                 } else {
@@ -1061,9 +1061,7 @@ impl Solver {
             if closed {
                 rec.normal_force = c.force;
                 rec.shear_force = match rec.state {
-                    ContactState::Lock => {
-                        p.contact.shear_penalty_ratio * rec.penalty * c.shear.norm()
-                    }
+                    ContactState::Lock => p.contact.shear_penalty(rec.penalty) * c.shear.norm(),
                     _ => {
                         let n_prev = if p.method == Method::Alm {
                             rec.lambda
