@@ -1116,9 +1116,10 @@ impl Solver {
             for v in &mut b.vertices {
                 *v = map.apply(v);
             }
-            for (pt, force) in &mut b.loads {
+            // Point loads are dead loads: the point moves with the block, the force keeps its
+            // direction in space (as in Shi's code).
+            for (pt, _) in &mut b.loads {
                 *pt = map.apply(pt);
-                *force = map.rotation() * *force;
             }
             b.refresh();
         }
