@@ -247,6 +247,10 @@ fn debug_log() -> bool {
     *ON.get_or_init(|| std::env::var_os("DDA3D_DEBUG").is_some_and(|v| v != "0"))
 }
 
+/// Iterations of an ALM loop (after the first) at which (P21) may raise penalties. Each raise
+/// means a new factorization; later iterations only update λ and reuse it (back-substitutions).
+const PENALTY_ROUNDS: u32 = 2;
+
 /// Penetrations below this fraction of the ALM tolerance ε1·d_n,max do not raise the penalty.
 const PENALTY_FLOOR: f64 = 0.01;
 
@@ -772,7 +776,7 @@ impl Solver {
                 c.dn_prev = None;
             }
             let mut alm_converged = false;
-            for _ in 0..cp.max_alm_iterations {
+            for alm_k in 1..=cp.max_alm_iterations {
                 let t0 = Instant::now();
                 if k_dirty {
                     for (i, kd) in kmat.diag.iter_mut().enumerate() {
@@ -865,6 +869,7 @@ impl Solver {
                     // many steps it ratcheted every penalty of a standing wall up to γE, a
                     // stiffness that turned a 4 µm motion into meganewtons at the next impact.
                     if let Some(prev) = c.dn_prev
+                        && alm_k <= PENALTY_ROUNDS + 1
                         && !(conv1 && conv2)
                         && c.dn.abs() > cp.beta * prev.abs()
                         && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * dn_max
