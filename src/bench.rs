@@ -60,6 +60,7 @@ pub fn growth_exponent(x: &[f64], y: &[f64]) -> f64 {
 pub fn run(
     scene_path: &Path,
     sizes: &[usize],
+    standing_sizes: &[usize],
     repeat: usize,
     scaling_duration: f64,
 ) -> Result<(), String> {
@@ -111,11 +112,11 @@ pub fn run(
         walls[0] / walls[1]
     );
 
-    if sizes.is_empty() {
-        return Ok(());
+    if !sizes.is_empty() {
+        scaling_table(sizes, repeat, scaling_duration, true)?;
     }
-    for rock in [true, false] {
-        scaling_table(sizes, repeat, scaling_duration, rock)?;
+    if !standing_sizes.is_empty() {
+        scaling_table(standing_sizes, repeat, scaling_duration, false)?;
     }
     Ok(())
 }

@@ -114,9 +114,12 @@ pub struct BenchArgs {
     /// The rockfall scene to time.
     #[arg(long, default_value = "scenes/rock_column_rockfall.toml")]
     pub scene: PathBuf,
-    /// Generated wall sizes for the scaling study (comma separated; empty to skip).
-    #[arg(long, value_delimiter = ',', default_value = "10,100,1000")]
+    /// Generated wall sizes for the scaling study with the rockfall (comma separated).
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "10,100")]
     pub sizes: Vec<usize>,
+    /// Generated wall sizes for the scaling study of a standing wall (no rock).
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "10,100,1000")]
+    pub standing_sizes: Vec<usize>,
     /// Runs per measurement; the fastest is reported.
     #[arg(long, default_value_t = 3)]
     pub repeat: usize,
@@ -351,8 +354,14 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
             "--scaling-duration must be positive".into(),
         ));
     }
-    crate::bench::run(&args.scene, &args.sizes, args.repeat, args.scaling_duration)
-        .map_err(CliError::Run)
+    crate::bench::run(
+        &args.scene,
+        &args.sizes,
+        &args.standing_sizes,
+        args.repeat,
+        args.scaling_duration,
+    )
+    .map_err(CliError::Run)
 }
 
 /// `dda3d render`: the solver runs on this thread and hands a snapshot to the capture pipeline

@@ -16,6 +16,16 @@ pub struct RunWriter {
     dir: PathBuf,
 }
 
+/// Shortest round-trip text of a number, in exponent form when it is tiny (penetrations of
+/// 1e-16 m would otherwise print as thirty zeros).
+fn num(x: f64) -> String {
+    if x != 0.0 && x.abs() < 1e-4 {
+        format!("{x:e}")
+    } else {
+        x.to_string()
+    }
+}
+
 fn io_err(e: csv::Error) -> io::Error {
     io::Error::other(e)
 }
@@ -67,7 +77,7 @@ impl RunWriter {
 
     /// Appends the rows of one completed step.
     pub fn write(&mut self, s: &Snapshot) -> io::Result<()> {
-        let t = s.time.to_string();
+        let t = num(s.time);
         for b in &s.blocks {
             let c = b.centroid;
             let v = b.velocity;
@@ -75,17 +85,17 @@ impl RunWriter {
                 .write_record([
                     t.as_str(),
                     &b.name,
-                    &c[0].to_string(),
-                    &c[1].to_string(),
-                    &c[2].to_string(),
-                    &v[0].to_string(),
-                    &v[1].to_string(),
-                    &v[2].to_string(),
+                    &num(c[0]),
+                    &num(c[1]),
+                    &num(c[2]),
+                    &num(v[0]),
+                    &num(v[1]),
+                    &num(v[2]),
                 ])
                 .map_err(io_err)?;
         }
         for c in &s.contacts {
-            let f = |x: f64| x.to_string();
+            let f = num;
             self.contacts
                 .write_record([
                     t.clone(),

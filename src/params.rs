@@ -81,6 +81,17 @@ pub struct ContactParams {
     pub open_threshold: f64,
 }
 
+impl ContactParams {
+    /// p_τ of a locked contact whose normal penalty is `p_n`: `shear_penalty_ratio · p_n`, with
+    /// p_n capped at α·p_n,1. Following p_n keeps the shear spring stiffer than the block's
+    /// inertia term once the normal penalty has been raised (with p_n,1 alone the paper's sliding
+    /// block stays half-locked at its first step). The cap stops a contact stiffened to γE by
+    /// (P21) from welding its neighbours together in shear.
+    pub fn shear_penalty(&self, p_n: f64) -> f64 {
+        self.shear_penalty_ratio * p_n.min(self.alpha * self.initial_penalty)
+    }
+}
+
 impl Default for ContactParams {
     fn default() -> Self {
         // Paper §3.1: p_n,1 = 0.01 E with E = 2e10 Pa, α = 10, β = 0.25, γ = 100, ε1 = ε2 = 0.01.

@@ -241,6 +241,16 @@ pub struct RunTotals {
     pub timings: Timings,
 }
 
+/// `DDA3D_DEBUG=1` logs every state change and every Δt cut to stderr (for tuning).
+fn debug_log() -> bool {
+    static ON: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *ON.get_or_init(|| std::env::var_os("DDA3D_DEBUG").is_some_and(|v| v != "0"))
+}
+
+/// Iterations of an ALM loop (after the first) at which (P21) may raise penalties. Each raise
+/// means a new factorization; later iterations only update λ and reuse it (back-substitutions).
+const PENALTY_ROUNDS: u32 = 2;
+
 /// Penetrations below this fraction of the ALM tolerance ε1·d_n,max do not raise the penalty.
 const PENALTY_FLOOR: f64 = 0.01;
 
@@ -407,7 +417,7 @@ impl Solver {
                             }
                         }
                     }
-                    if std::env::var_os("DDA3D_DEBUG_CUTS").is_some() {
+                    if debug_log() {
                         let why = match &reason {
                             Retry::OpenClose => "open-close".to_string(),
                             Retry::Displacement(r) => format!("displacement r={r:.2}"),
@@ -712,7 +722,7 @@ impl Solver {
         match c.rec.state {
             ContactState::Lock => {
                 let delta = c.cand.xa - c.rec.reference;
-                let p_tau = cp.shear_penalty_ratio * c.rec.penalty;
+                let p_tau = cp.shear_penalty(c.rec.penalty);
                 add_shear_spring(&mut t, &c.ta, &tb, &c.cand.normal, &delta, p_tau, with_k);
             }
             ContactState::Slide => {
@@ -766,7 +776,7 @@ impl Solver {
                 c.dn_prev = None;
             }
             let mut alm_converged = false;
-            for _ in 0..cp.max_alm_iterations {
+            for alm_k in 1..=cp.max_alm_iterations {
                 let t0 = Instant::now();
                 if k_dirty {
                     for (i, kd) in kmat.diag.iter_mut().enumerate() {
@@ -859,6 +869,7 @@ impl Solver {
                     // many steps it ratcheted every penalty of a standing wall up to γE, a
                     // stiffness that turned a 4 µm motion into meganewtons at the next impact.
                     if let Some(prev) = c.dn_prev
+                        && alm_k <= PENALTY_ROUNDS + 1
                         && !(conv1 && conv2)
                         && c.dn.abs() > cp.beta * prev.abs()
                         && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * dn_max
@@ -867,7 +878,7 @@ impl Solver {
                         if capped > c.rec.penalty {
                             // Keep the shear spring's force as its stiffness (p_τ ∝ p_n) grows:
                             // shorten the spring instead, so that no energy is created.
-                            let shrink = c.rec.penalty / capped;
+                            let shrink = cp.shear_penalty(c.rec.penalty) / cp.shear_penalty(capped);
                             let delta = c.cand.xa - c.rec.reference;
                             c.rec.reference = c.cand.xa - delta * shrink;
                             c.rec.penalty = capped;
@@ -929,7 +940,7 @@ impl Solver {
                                 let delta = c.cand.xa - c.rec.reference;
                                 let r = delta + du;
                                 c.shear = r - n * n.dot(&r);
-                                let shear = cp.shear_penalty_ratio * c.rec.penalty * c.shear.norm();
+                                let shear = cp.shear_penalty(c.rec.penalty) * c.shear.norm();
                                 let cohesion = if c.rec.intact {
                                     p.joint.cohesion * c.rec.cohesion_area
                                 } else {
@@ -960,6 +971,22 @@ impl Solver {
                         }
                     }
                 }
+                if c.rec.state != before && debug_log() {
+                    eprintln!(
+                        "t={:.4} dt={dt:.2e} pass {oc_passes}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} pair={}-{}",
+                        self.time,
+                        before,
+                        c.rec.state,
+                        c.cand.key.mode,
+                        c.force,
+                        c.dn,
+                        c.rec.penalty,
+                        c.shear.norm(),
+                        c.slip.norm(),
+                        c.cand.key.i,
+                        c.cand.key.j
+                    );
+                }
                 if c.rec.state != before {
                     c.flips += 1;
                     if c.flips > MAX_FLIPS {
@@ -983,24 +1010,6 @@ impl Solver {
                 }
             }
             timings += t2.elapsed();
-            if changed && std::env::var_os("DDA3D_DEBUG_OC").is_some() {
-                for c in active.iter() {
-                    if c.rec.state != c.start.state {
-                        eprintln!(
-                            "t={:.4} dt={dt:.2e} pass {oc_passes}: {:?} {:?}->{:?} dn={:.3e} N={:.3e} p={:.1e} shear={:.3e} slip={:.3e}",
-                            self.time,
-                            c.cand.key,
-                            c.start.state,
-                            c.rec.state,
-                            c.dn,
-                            c.force,
-                            c.rec.penalty,
-                            c.shear.norm(),
-                            c.slip.norm()
-                        );
-                    }
-                }
-            }
             if !changed {
                 converged_states = true;
                 break;
@@ -1057,9 +1066,7 @@ impl Solver {
             if closed {
                 rec.normal_force = c.force;
                 rec.shear_force = match rec.state {
-                    ContactState::Lock => {
-                        p.contact.shear_penalty_ratio * rec.penalty * c.shear.norm()
-                    }
+                    ContactState::Lock => p.contact.shear_penalty(rec.penalty) * c.shear.norm(),
                     _ => {
                         let n_prev = if p.method == Method::Alm {
                             rec.lambda
@@ -1114,9 +1121,10 @@ impl Solver {
             for v in &mut b.vertices {
                 *v = map.apply(v);
             }
-            for (pt, force) in &mut b.loads {
+            // Point loads are dead loads: the point moves with the block, the force keeps its
+            // direction in space (as in Shi's code).
+            for (pt, _) in &mut b.loads {
                 *pt = map.apply(pt);
-                *force = map.rotation() * *force;
             }
             b.refresh();
         }

@@ -163,3 +163,35 @@ fn touching_blocks_are_accepted() {
     let summary = std::fs::read_to_string(dir.join("o/summary.json")).unwrap();
     assert!(summary.contains("\"status\": \"completed\""));
 }
+
+/// A run that cannot go on stops with a message, exit status 1, and keeps what it wrote.
+#[test]
+fn diverging_run_keeps_its_output() {
+    let dir = tmp("diverge");
+    let path = dir.join("fast.toml");
+    // 1 km/s: even the smallest step (Δt_max/100) moves the block far beyond δ·w0.
+    std::fs::write(
+        &path,
+        GOOD.replace("box = {", "velocity = [1000.0, 0.0, 0.0]\nbox = {"),
+    )
+    .unwrap();
+    let out = bin()
+        .arg("run")
+        .arg(&path)
+        .arg("--out")
+        .arg(dir.join("o"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("diverged") && err.contains("fast.toml"),
+        "{err}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("o/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["status"], "diverged");
+    let blocks = std::fs::read_to_string(dir.join("o/blocks.csv")).unwrap();
+    assert!(blocks.lines().count() >= 2, "the initial state was written");
+}

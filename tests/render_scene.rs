@@ -5,7 +5,6 @@ mod render_support;
 
 use dda3d::render::capture::render_rgba;
 use dda3d::render::mesh::BLOCK_PALETTE_SRGB;
-use dda3d::render::scene::BACKGROUND_SRGB;
 use dda3d::render::{CaptureOptions, Offscreen};
 use dda3d::scene;
 use dda3d::solver::Solver;
@@ -13,15 +12,6 @@ use render_support::*;
 
 const W: u32 = 1280;
 const H: u32 = 720;
-
-fn is_background(px: [u8; 4]) -> bool {
-    let bg = [
-        (BACKGROUND_SRGB >> 16) as u8,
-        (BACKGROUND_SRGB >> 8) as u8,
-        BACKGROUND_SRGB as u8,
-    ];
-    (0..3).all(|k| px[k].abs_diff(bg[k]) <= 1) && px[3] == 255
-}
 
 fn blue(img: &[u8]) -> usize {
     img.chunks_exact(4)

@@ -5,7 +5,6 @@ mod render_support;
 
 use dda3d::render::capture::{render_rgba, write_png};
 use dda3d::render::mesh::{BLOCK_PALETTE_SRGB, FIXED_BLOCK_SRGB};
-use dda3d::render::scene::BACKGROUND_SRGB;
 use dda3d::render::{CaptureOptions, Offscreen, render_to_png};
 use dda3d::snapshot::ContactState;
 use render_support::*;
@@ -17,15 +16,6 @@ fn out_dir() -> std::path::PathBuf {
     let d = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_slope");
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-fn is_background(px: [u8; 4]) -> bool {
-    let bg = [
-        (BACKGROUND_SRGB >> 16) as u8,
-        (BACKGROUND_SRGB >> 8) as u8,
-        BACKGROUND_SRGB as u8,
-    ];
-    (0..3).all(|k| px[k].abs_diff(bg[k]) <= 1) && px[3] == 255
 }
 
 #[test]

@@ -480,21 +480,33 @@ mod tests {
     fn force_arrow_length_follows_scale() {
         let s = snap(vec![contact(1000.0, ContactState::Lock)]);
         let style = SceneStyle {
-            force_scale: Some(500.0),
+            force_scale: Some(2000.0),
             grid: false,
             ..Default::default()
         };
         let frame = SceneFrame::of_snapshot(&s);
         let scene = Scene::build(&s, &style, &frame).unwrap();
-        assert_eq!(scene.force_scale, Some(500.0));
-        // 1000 N at 500 N/m → 2 m arrow from the contact point along +z.
+        assert_eq!(scene.force_scale, Some(2000.0));
+        // 1000 N at 2000 N/m → 0.5 m arrow from the contact point along +z.
         let base = scene.to_local([0.0, 0.0, 1.0]);
         let top = scene
             .arrows
             .iter()
             .map(|v| v.position[2] - base.z)
             .fold(f32::MIN, f32::max);
-        assert!((top - 2.0).abs() < 1e-4, "arrow top {top}");
+        assert!((top - 0.5).abs() < 1e-4, "arrow top {top}");
+        // A force far beyond the scale is capped at 40 % of the view.
+        let big = snap(vec![contact(1e6, ContactState::Lock)]);
+        let capped = Scene::build(&big, &style, &frame).unwrap();
+        let top_big = capped
+            .arrows
+            .iter()
+            .map(|v| v.position[2] - base.z)
+            .fold(f32::MIN, f32::max);
+        assert!(
+            (top_big - 0.4 * frame.size() as f32).abs() < 1e-3,
+            "capped top {top_big}"
+        );
         assert_eq!(scene.contacts_lock, 1);
         let lock = srgb_to_linear(hex(LOCK_SRGB));
         assert!(scene.arrows.iter().all(|v| v.color == lock));

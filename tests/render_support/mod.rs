@@ -199,3 +199,10 @@ pub fn is_lock_blue(px: [u8; 4]) -> bool {
     let (r, g, b) = (px[0] as i32, px[1] as i32, px[2] as i32);
     b > 120 && b > r + 60 && b > g + 25
 }
+
+/// The light background colour, exactly (opaque).
+pub fn is_background(px: [u8; 4]) -> bool {
+    let bg = dda3d::render::scene::BACKGROUND_SRGB;
+    let bg = [(bg >> 16) as u8, (bg >> 8) as u8, bg as u8];
+    (0..3).all(|k| px[k].abs_diff(bg[k]) <= 1) && px[3] == 255
+}
