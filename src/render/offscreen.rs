@@ -106,20 +106,7 @@ impl Offscreen {
         let renderer = Renderer::with_max_samples(&gpu, format, max_samples);
         let overlay = Overlay::new(&gpu.device, format);
         let targets = renderer.create_targets(&gpu.device, width, height);
-        let output = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("dda3d frame"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let output = readable_target(&gpu.device, "dda3d frame", format, width, height);
         let output_view = output.create_view(&Default::default());
         let slots = (0..2)
             .map(|_| Slot {
@@ -285,4 +272,29 @@ mod tests {
         assert_eq!(out.len(), 24);
         assert_eq!(&out[8..16], &[10, 11, 12, 13, 14, 15, 16, 17]);
     }
+}
+
+/// A single-sample colour target that can be drawn into and then copied to a buffer for reading
+/// back (frames, screenshots).
+pub fn readable_target(
+    device: &wgpu::Device,
+    label: &str,
+    format: wgpu::TextureFormat,
+    width: u32,
+    height: u32,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
 }

@@ -928,20 +928,13 @@ struct WindowCapture {
 
 impl WindowCapture {
     fn new(gpu: &Gpu, format: wgpu::TextureFormat, width: u32, height: u32) -> WindowCapture {
-        let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("dda3d window capture"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
+        let texture = crate::render::offscreen::readable_target(
+            &gpu.device,
+            "dda3d window capture",
             format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+            width,
+            height,
+        );
         let view = texture.create_view(&Default::default());
         let padded_row = padded_bytes_per_row(width);
         let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
