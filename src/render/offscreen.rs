@@ -251,29 +251,6 @@ impl Offscreen {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn row_padding() {
-        assert_eq!(padded_bytes_per_row(64), 256);
-        assert_eq!(padded_bytes_per_row(65), 512);
-        assert_eq!(padded_bytes_per_row(1280), 5120);
-        assert_eq!(padded_bytes_per_row(1), 256);
-        // 3 rows of 2 pixels, padded to 256 bytes.
-        let mut data = vec![0u8; 256 * 3];
-        for r in 0..3 {
-            for b in 0..8 {
-                data[r * 256 + b] = (r * 10 + b) as u8;
-            }
-        }
-        let out = strip_row_padding(&data, 2, 3, 256);
-        assert_eq!(out.len(), 24);
-        assert_eq!(&out[8..16], &[10, 11, 12, 13, 14, 15, 16, 17]);
-    }
-}
-
 /// A single-sample colour target that can be drawn into and then copied to a buffer for reading
 /// back (frames, screenshots).
 pub fn readable_target(
@@ -297,4 +274,27 @@ pub fn readable_target(
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn row_padding() {
+        assert_eq!(padded_bytes_per_row(64), 256);
+        assert_eq!(padded_bytes_per_row(65), 512);
+        assert_eq!(padded_bytes_per_row(1280), 5120);
+        assert_eq!(padded_bytes_per_row(1), 256);
+        // 3 rows of 2 pixels, padded to 256 bytes.
+        let mut data = vec![0u8; 256 * 3];
+        for r in 0..3 {
+            for b in 0..8 {
+                data[r * 256 + b] = (r * 10 + b) as u8;
+            }
+        }
+        let out = strip_row_padding(&data, 2, 3, 256);
+        assert_eq!(out.len(), 24);
+        assert_eq!(&out[8..16], &[10, 11, 12, 13, 14, 15, 16, 17]);
+    }
 }
