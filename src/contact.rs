@@ -2,8 +2,6 @@
 //! edge-to-edge entrance modes), the normal distance and its linearisation (P3)–(P8), and the
 //! contact submatrices (P10), (P15), (P20).
 
-use std::collections::HashMap;
-
 use crate::geometry::{Topology, Vec3};
 use crate::mechanics::{Mat3x12, Mat12, Vec12, displacement_matrix};
 pub use crate::snapshot::{ContactMode, ContactState};
@@ -414,18 +412,6 @@ pub struct ContactTerms {
     pub f_j: Vec12,
 }
 
-impl ContactTerms {
-    pub fn zero() -> Self {
-        ContactTerms {
-            k_ii: Mat12::zeros(),
-            k_ij: Mat12::zeros(),
-            k_jj: Mat12::zeros(),
-            f_i: Vec12::zeros(),
-            f_j: Vec12::zeros(),
-        }
-    }
-}
-
 /// Normal stiffness of a closed contact, (P10a)–(P10d).
 pub fn add_normal_stiffness(t: &mut ContactTerms, k: &NormalKinematics, penalty: f64) {
     t.k_ii += k.g_i * k.g_i.transpose() * penalty;
@@ -510,16 +496,6 @@ pub fn planar_hull_area(points: &[Vec3], n: &Vec3) -> f64 {
         area += a.0 * b.1 - b.0 * a.1;
     }
     area.abs() / 2.0
-}
-
-/// Groups candidate indices by block pair (i.e. by joint).
-pub fn by_pair(cands: &[Candidate]) -> HashMap<(u32, u32), Vec<usize>> {
-    let mut m: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
-    for (k, c) in cands.iter().enumerate() {
-        let (a, b) = (c.key.i.min(c.key.j), c.key.i.max(c.key.j));
-        m.entry((a, b)).or_default().push(k);
-    }
-    m
 }
 
 #[cfg(test)]
@@ -726,7 +702,7 @@ mod tests {
         let delta = xa - xb;
         let tau = (r * Vec3::new(0.6, 0.8, 0.0)).normalize();
         let (p_tau, fric) = (1.2e8, 7.0e3);
-        let mut t = ContactTerms::zero();
+        let mut t = ContactTerms::default();
         add_normal_stiffness(&mut t, &k, p);
         add_normal_force(&mut t, &k, p, lambda);
         add_shear_spring(&mut t, &ta, &tb, &n, &delta, p_tau, true);

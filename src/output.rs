@@ -149,6 +149,8 @@ pub struct Summary {
     pub contacts_per_step: f64,
     pub unconverged_steps: u64,
     pub alm_cap_hits: u64,
+    /// Contacts settled (closed, sliding) after cycling between states within one step.
+    pub frozen_contacts: u64,
     /// Seconds spent in each phase.
     pub timings: Timings,
 }
@@ -173,6 +175,7 @@ impl Summary {
             contacts_per_step: t.contacts_per_step,
             unconverged_steps: t.unconverged_steps,
             alm_cap_hits: t.alm_cap_hits,
+            frozen_contacts: t.frozen_contacts,
             timings: t.timings.clone(),
         }
     }

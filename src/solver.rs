@@ -385,7 +385,7 @@ impl Solver {
         let mut cuts = 0u32;
         let mut factorizations = 0u32;
         let (d, oc, alm) = loop {
-            match self.attempt(&mut active, &mut kmat, dt, &mut factorizations) {
+            match self.iterate(&mut active, &mut kmat, dt, &mut factorizations, false) {
                 Ok((d, oc, alm)) => break (d, oc, alm),
                 Err(reason) => {
                     let at_floor = dt <= dt_floor * (1.0 + 1e-9);
@@ -637,17 +637,6 @@ impl Solver {
         (active, near)
     }
 
-    /// One attempt at the step with length `dt`: the open–close loop around the ALM loop.
-    fn attempt(
-        &mut self,
-        active: &mut [Active],
-        kmat: &mut BlockMatrix,
-        dt: f64,
-        factorizations: &mut u32,
-    ) -> Result<(Vec<f64>, u32, u32), Retry> {
-        self.iterate(active, kmat, dt, factorizations, false)
-    }
-
     /// The last resort at the Δt floor: accept the state of the final open–close pass.
     fn attempt_accept_any(
         &mut self,
@@ -707,7 +696,7 @@ impl Solver {
     fn contact_terms(&self, c: &Active, with_k: bool) -> ContactTerms {
         let p = &self.params;
         let cp = &p.contact;
-        let mut t = ContactTerms::zero();
+        let mut t = ContactTerms::default();
         if with_k {
             add_normal_stiffness(&mut t, &c.kin, c.rec.penalty);
         }
@@ -740,6 +729,9 @@ impl Solver {
         t
     }
 
+    /// One attempt at the step with length `dt`: the open–close loop around the ALM loop.
+    /// `accept_any` (the last resort at the Δt floor) returns the final pass even when the
+    /// states still change.
     fn iterate(
         &mut self,
         active: &mut [Active],
