@@ -160,6 +160,13 @@ fn vertex_face(
             continue;
         }
         let mut best: Option<Candidate> = None;
+        let vertex_edge = a.topo.vertex_edges[vi]
+            .iter()
+            .map(|&ei| {
+                let e = a.topo.edges[ei];
+                (a.vertices[e.v[1]] - a.vertices[e.v[0]]).norm()
+            })
+            .fold(0.0, f64::max);
         for (fi, face) in b.topo.faces.iter().enumerate() {
             let n = b.face_normals[fi];
             let q0 = b.vertices[face[0]];
@@ -167,10 +174,22 @@ fn vertex_face(
             if gap < -p.max_penetration || gap > p.search_distance {
                 continue;
             }
+            // The slack covers the blind spot the edge–edge test leaves near edge ends (closest
+            // points within ε_e of an end are refused there): a vertex a few millimetres
+            // outside a face, beside the face's edge, is caught here, against the face's plane.
+            // Without it a corner of one block near a corner of another (every joint of a
+            // wall of aligned blocks) is seen by neither test, can move into the neighbour
+            // unseen within a step, and the next step pushes it out with a burst of energy.
+            let face_edge = (0..face.len())
+                .map(|m| (b.vertices[face[(m + 1) % face.len()]] - b.vertices[face[m]]).norm())
+                .fold(0.0, f64::max);
+            let slack = p
+                .inside_tolerance
+                .max(2.0 * p.edge_margin * face_edge.max(vertex_edge));
             let inside = (0..face.len()).all(|m| {
                 let qm = b.vertices[face[m]];
                 let e = b.vertices[face[(m + 1) % face.len()]] - qm;
-                (pv - qm).dot(&n.cross(&e.normalize())) >= -p.inside_tolerance
+                (pv - qm).dot(&n.cross(&e.normalize())) >= -slack
             });
             if !inside {
                 continue;
@@ -796,6 +815,41 @@ mod tests {
             assert!((k.gap + 0.001).abs() < 1e-12, "penetration 1 mm: {}", k.gap);
             assert!(k.normal.z.abs() > 0.999);
         }
+    }
+
+    #[test]
+    fn a_corner_just_beside_a_face_edge_is_still_a_vertex_face_contact() {
+        // The upper cube's corner hangs 0.5 mm beyond the lower cube's top edge, 0.1 mm above
+        // its top plane. Its edges run parallel to, or end at, the lower cube's edges, so the
+        // edge–edge test refuses them all; before the slack of the point-in-face test nothing
+        // saw this corner, and a small move took it into the lower cube unseen.
+        let lower = owned(box_vertices([1.0; 3], [0.5, 0.5, 0.5], &Mat3::identity()));
+        let upper = owned(box_vertices(
+            [1.0; 3],
+            [1.5005, 0.8, 1.5001],
+            &Mat3::identity(),
+        ));
+        let c = detect_pair(0, &shape(&lower), 1, &shape(&upper), &params(), &|_| false);
+        assert!(
+            c.iter().all(|k| k.mode() == ContactMode::VertexFace),
+            "{c:#?}"
+        );
+        let corner = c
+            .iter()
+            .find(|k| k.key.i == 1 && (k.xa - Vec3::new(1.0005, 0.3, 1.0001)).norm() < 1e-9)
+            .unwrap_or_else(|| panic!("the corner is a contact: {c:#?}"));
+        // Of the two faces at the edge, the common-plane rule keeps the one with the larger
+        // gap: the side face x = 1, 0.5 mm away.
+        assert!((corner.gap - 5e-4).abs() < 1e-12, "{corner:#?}");
+        assert!((corner.normal - Vec3::x()).norm() < 1e-12);
+        // 5 mm beyond the edge and 5 mm above (more than the slack, 2 ε_e × 1 m) it is not.
+        let far = owned(box_vertices(
+            [1.0; 3],
+            [1.505, 0.8, 1.505],
+            &Mat3::identity(),
+        ));
+        let c = detect_pair(0, &shape(&lower), 1, &shape(&far), &params(), &|_| false);
+        assert!(c.iter().all(|k| k.key.i != 1), "{c:#?}");
     }
 
     #[test]

@@ -103,7 +103,7 @@ pub struct StepStats {
     /// Linear solves (ALM iterations, or one per open–close pass in penalty mode) in the
     /// accepted attempt.
     pub alm_iterations: u32,
-    /// Attempts discarded before this step was accepted (displacement limit, open–close limit).
+    /// Attempts discarded before this step was accepted (displacement or penetration limit).
     pub time_step_cuts: u32,
     /// Numeric factorizations in this step, all attempts.
     pub factorizations: u32,
@@ -119,6 +119,8 @@ pub struct StepStats {
     pub kinetic_energy: f64,
     /// Gravitational potential energy Σ m g·(−x_c) relative to the origin, J.
     pub potential_energy: f64,
+    /// Elastic strain energy Σ ½ V σ·ε of the blocks, J.
+    pub elastic_energy: f64,
 }
 
 /// The state of a run at the end of a completed step (step 0 is the initial state).
