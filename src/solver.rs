@@ -242,13 +242,13 @@ pub struct RunTotals {
     pub factorizations: u64,
     pub symbolic_analyses: u64,
     pub max_penetration: f64,
-    /// Steps whose open–close iteration did not converge within its pass limit and was settled
-    /// (the contacts still changing closed and locked for one more solve).
+    /// Steps at the Δt floor whose open–close iteration did not converge within its pass limit
+    /// and was settled (the contacts still changing closed and locked for one more solve).
     pub unconverged_steps: u64,
     /// ALM loops that hit the iteration cap.
     pub alm_cap_hits: u64,
-    /// Contacts settled closed and locked: after cycling between states within one step, or
-    /// still changing at the open–close pass limit.
+    /// Contacts settled closed and locked: after cycling between states within one attempt, or
+    /// still changing at the open–close pass limit at the Δt floor.
     pub frozen_contacts: u64,
     pub contacts_per_step: f64,
     pub timings: Timings,
@@ -280,6 +280,7 @@ struct Solved {
 }
 
 enum Retry {
+    OpenClose,
     Displacement(f64),
     Penetration(f64),
     NotFinite,
@@ -406,15 +407,16 @@ impl Solver {
         let mut cuts = 0u32;
         let mut factorizations = 0u32;
         let (d, oc, alm) = loop {
-            match self.iterate(&mut active, &mut kmat, dt, &mut factorizations) {
+            let at_floor = dt <= dt_floor * (1.0 + 1e-9);
+            match self.iterate(&mut active, &mut kmat, dt, at_floor, &mut factorizations) {
                 Ok(r) => {
                     self.totals.unconverged_steps += r.settled as u64;
                     break (r.d, r.oc_passes, r.solves);
                 }
                 Err(reason) => {
-                    let at_floor = dt <= dt_floor * (1.0 + 1e-9);
                     if at_floor {
                         match reason {
+                            Retry::OpenClose => unreachable!("settled at the floor"),
                             Retry::NotFinite => {
                                 return Err(self.diverged("the solution is not finite"));
                             }
@@ -432,6 +434,7 @@ impl Solver {
                     }
                     if debug_log() {
                         let why = match &reason {
+                            Retry::OpenClose => "open-close".to_string(),
                             Retry::Displacement(r) => format!("displacement r={r:.2}"),
                             Retry::Penetration(p) => format!("penetration {p:.2e}"),
                             Retry::NotFinite => "not finite".to_string(),
@@ -543,16 +546,45 @@ impl Solver {
         if self.params.mode == Mode::Static {
             return dt;
         }
-        for b in self.model.blocks.iter().filter(|b| !b.fixed) {
+        let search = self.detection_params().search_distance;
+        for (i, b) in self
+            .model
+            .blocks
+            .iter()
+            .enumerate()
+            .filter(|(_, b)| !b.fixed)
+        {
             let v = &b.velocity;
             let r = b.radius();
             let speed = Vec3::new(v[0], v[1], v[2]).norm()
                 + Vec3::new(v[3], v[4], v[5]).norm() * r
                 + v.fixed_rows::<6>(6).norm() * r;
             let t = (-speed + (speed * speed + 2.0 * a * allowed).sqrt()) / a;
-            dt = dt.min(t);
+            if t < dt {
+                let dt_max = self.params.max_time_step;
+                let reach = speed * dt_max + 0.5 * a * dt_max * dt_max + search;
+                if self.isolated(i, reach) {
+                    continue;
+                }
+                dt = t;
+            }
         }
         dt.max(self.params.max_time_step / 100.0)
+    }
+
+    /// True when no other block comes within `reach` of block `i`'s bounding box: a block in
+    /// free flight. The constant-acceleration step integrates its motion exactly, and δ·w0,
+    /// which keeps the contact linearisation and the detection window valid, need not limit
+    /// its step. (A rock that bounced off the ground slab's edge fell for 90 s at the Δt floor
+    /// and was then reported as diverged.)
+    fn isolated(&self, i: usize, reach: f64) -> bool {
+        let b = &self.model.blocks[i];
+        let (lo, hi) = (b.lo - Vec3::repeat(reach), b.hi + Vec3::repeat(reach));
+        self.model
+            .blocks
+            .iter()
+            .enumerate()
+            .all(|(k, o)| k == i || (0..3).any(|d| o.hi[d] < lo[d] || o.lo[d] > hi[d]))
     }
 
     /// Detects this step's contacts and attaches each to its record from the last step, or to a
@@ -756,6 +788,7 @@ impl Solver {
         active: &mut [Active],
         kmat: &mut BlockMatrix,
         dt: f64,
+        at_floor: bool,
         factorizations: &mut u32,
     ) -> Result<Solved, Retry> {
         let p = self.params.clone();
@@ -778,13 +811,16 @@ impl Solver {
             c.flips = 0;
             c.frozen = false;
         }
-        // After the last open–close pass, one more solve with the contacts that still changed
-        // settled closed and locked, and the step is accepted. Shi's code cuts Δt to 0.3 Δt
-        // instead; in a wall of many blocks the contacts that carry almost nothing flip at every
-        // pass, whatever Δt, and the cuts multiplied the steps without settling them.
+        // If the open–close iteration has not converged after its pass limit, the attempt is
+        // redone with 0.3 Δt (Shi). At the Δt floor, the last resort: one more solve with the
+        // contacts that still changed settled closed and locked, and the step is accepted.
         let mut settling = false;
         for oc_idx in 0..=cp.max_open_close_iterations {
             if oc_idx == cp.max_open_close_iterations {
+                if !at_floor {
+                    self.totals.timings.assembly += timings.as_secs_f64();
+                    return Err(Retry::OpenClose);
+                }
                 for c in active.iter_mut().filter(|c| c.changed) {
                     c.settle();
                     self.totals.frozen_contacts += 1;
@@ -1038,12 +1074,20 @@ impl Solver {
         self.totals.timings.assembly += timings.as_secs_f64();
         // Step size checks on the converged solution.
         let allowed = p.max_displacement_ratio * self.w0;
+        let search = self.detection_params().search_distance;
         let mut max_u: f64 = 0.0;
         for (i, b) in self.model.blocks.iter().enumerate() {
             let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
-            for v in &b.vertices {
-                max_u = max_u.max((displacement_matrix(&(v - b.mp.centroid)) * di).norm());
+            let u = b
+                .vertices
+                .iter()
+                .map(|v| (displacement_matrix(&(v - b.mp.centroid)) * di).norm())
+                .fold(0.0, f64::max);
+            // A block in free flight may move further (see `isolated`).
+            if u > allowed && self.isolated(i, u + search) {
+                continue;
             }
+            max_u = max_u.max(u);
         }
         let r = max_u / allowed;
         if r > p.max_displacement_overshoot {

@@ -169,10 +169,15 @@ fn touching_blocks_are_accepted() {
 fn diverging_run_keeps_its_output() {
     let dir = tmp("diverge");
     let path = dir.join("fast.toml");
-    // 1 km/s: even the smallest step (Δt_max/100) moves the block far beyond δ·w0.
+    // 1 km/s toward a fixed block 3 m away: even the smallest step (Δt_max/100) moves the
+    // block far beyond δ·w0. (Alone in open space it would just fly: free flight is exact.)
+    let wall = "[[blocks]]\nname = \"wall\"\nmaterial = \"rock\"\nfixed = true\nbox = { size = [1, 1, 1], center = [4, 0, 0.5] }\n";
     std::fs::write(
         &path,
-        GOOD.replace("box = {", "velocity = [1000.0, 0.0, 0.0]\nbox = {"),
+        format!(
+            "{}{wall}",
+            GOOD.replace("box = {", "velocity = [1000.0, 0.0, 0.0]\nbox = {")
+        ),
     )
     .unwrap();
     let out = bin()
