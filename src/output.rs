@@ -139,8 +139,10 @@ pub struct Summary {
     pub steps: u64,
     pub simulated_time: f64,
     pub wall_seconds: f64,
-    /// Largest penetration of a closed contact over the run, m.
+    /// Largest penetration of a closed contact over the run beyond its kept overlap, m.
     pub max_penetration: f64,
+    /// Largest overlap kept by a contact over the run, m (see `StepStats::max_overlap`).
+    pub max_overlap: f64,
     pub open_close_iterations: u64,
     pub alm_iterations: u64,
     pub time_step_cuts: u64,
@@ -149,7 +151,7 @@ pub struct Summary {
     pub contacts_per_step: f64,
     pub unconverged_steps: u64,
     pub alm_cap_hits: u64,
-    /// Contacts settled (closed, sliding) after cycling between states within one step.
+    /// Contacts settled after cycling between states within one attempt, or at the Δt floor.
     pub frozen_contacts: u64,
     /// Seconds spent in each phase.
     pub timings: Timings,
@@ -167,6 +169,7 @@ impl Summary {
             simulated_time: time,
             wall_seconds: wall,
             max_penetration: t.max_penetration,
+            max_overlap: t.max_overlap,
             open_close_iterations: t.open_close_iterations,
             alm_iterations: t.alm_iterations,
             time_step_cuts: t.time_step_cuts,

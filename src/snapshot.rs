@@ -107,8 +107,13 @@ pub struct StepStats {
     pub time_step_cuts: u32,
     /// Numeric factorizations in this step, all attempts.
     pub factorizations: u32,
-    /// Largest penetration over closed contacts, m.
+    /// Largest penetration of a closed contact at the end of the step, m, beyond the overlap it
+    /// keeps (what the ALM tolerance ε1·d_n,max controls).
     pub max_penetration: f64,
+    /// Largest overlap kept by a closed contact, m: a contact first seen already deeper than
+    /// ε1·d_n,max (missed by detection or by the linearised step) keeps that overlap instead of
+    /// having it pushed out at once, and releases 10 % of it a step.
+    pub max_overlap: f64,
     /// Closed contacts in the lock state.
     pub contacts_lock: u32,
     /// Closed contacts in the slide state.
