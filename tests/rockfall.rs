@@ -53,6 +53,29 @@ fn run(s: Scene) -> Outcome {
     }
 }
 
+impl Outcome {
+    /// Kinetic + gravitational + elastic energy never exceeds its start value by more than 1 % of
+    /// the rock's initial kinetic energy (contact springs only take energy away).
+    fn assert_no_energy_gain(&self, what: &str) {
+        assert!(
+            self.max_energy_gain < 0.01 * self.initial_kinetic,
+            "{what}: energy grew by {} J (initial kinetic {} J)",
+            self.max_energy_gain,
+            self.initial_kinetic
+        );
+    }
+
+    /// ε1·d_n,max, the ALM tolerance on penetration, m.
+    fn alm_bound(&self) -> f64 {
+        self.solver.params.contact.eps1 * self.solver.max_step_penetration()
+    }
+
+    /// The contact window 0.3·d_s: the deepest penetration still treated as a contact, m.
+    fn window(&self) -> f64 {
+        0.3 * 2.5 * self.solver.params.max_displacement_ratio * self.solver.w0()
+    }
+}
+
 fn displacement(s: &Solver, name: &str) -> f64 {
     let b = s
         .snapshot()
@@ -96,15 +119,8 @@ fn rockfall_collapses_the_column_with_both_methods() {
             o.vertex_face,
             o.edge_edge
         );
-        // Energy: kinetic + gravitational + elastic never exceeds its start value by more than
-        // 1 % of the rock's initial kinetic energy (contact springs only take energy away).
-        assert!(
-            o.max_energy_gain < 0.01 * o.initial_kinetic,
-            "{method:?}: energy grew by {} J (initial kinetic {} J)",
-            o.max_energy_gain,
-            o.initial_kinetic
-        );
-        let bound = solver.params.contact.eps1 * solver.max_step_penetration();
+        o.assert_no_energy_gain(&format!("{method:?}"));
+        let (bound, window) = (o.alm_bound(), o.window());
         println!(
             "{method:?}: {} steps, {} cuts, {} settled, max penetration {:.3e} m (ε1·d_n,max = {:.3e} m), max kept overlap {:.3e} m, energy gain {:.3e} J of {:.3e} J",
             solver.totals.steps,
@@ -125,7 +141,6 @@ fn rockfall_collapses_the_column_with_both_methods() {
             ),
             // DDA-3p penetrates N / p_n: bounded by the contact window, not by ε1.
             Method::Penalty => {
-                let window = 0.3 * 2.5 * solver.params.max_displacement_ratio * solver.w0();
                 assert!(
                     o.max_penetration < window,
                     "penalty penetration {} ≥ {window}",
@@ -135,7 +150,6 @@ fn rockfall_collapses_the_column_with_both_methods() {
         }
         // An overlap a contact is first seen with (the linearised step moved a corner past a
         // face it predicted open) is kept, not pushed out; no block passes through another.
-        let window = 0.3 * 2.5 * solver.params.max_displacement_ratio * solver.w0();
         assert!(
             o.max_overlap < window,
             "{method:?}: kept overlap {} m",
@@ -188,17 +202,11 @@ fn generated_wall_struck_by_the_rock_gains_no_energy() {
         o.max_penetration,
         o.max_overlap
     );
-    assert!(
-        o.max_energy_gain < 0.01 * o.initial_kinetic,
-        "energy grew by {} J (initial kinetic {} J)",
-        o.max_energy_gain,
-        o.initial_kinetic
-    );
-    let bound = solver.params.contact.eps1 * solver.max_step_penetration();
+    o.assert_no_energy_gain("wall of 40");
+    let bound = o.alm_bound();
     assert!(o.max_penetration < bound, "{} ≥ {bound}", o.max_penetration);
-    let window = 0.3 * 2.5 * solver.params.max_displacement_ratio * solver.w0();
     assert!(
-        o.max_overlap < 0.1 * window,
+        o.max_overlap < 0.1 * o.window(),
         "kept overlap {}",
         o.max_overlap
     );
