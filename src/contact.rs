@@ -155,6 +155,17 @@ fn vertex_face(
 ) {
     let lo = b.lo - Vec3::repeat(p.search_distance);
     let hi = b.hi + Vec3::repeat(p.search_distance);
+    // Longest edge of each face of b, for the slack of the point-in-face test below.
+    let face_edges: Vec<f64> = b
+        .topo
+        .faces
+        .iter()
+        .map(|face| {
+            (0..face.len())
+                .map(|m| (b.vertices[face[(m + 1) % face.len()]] - b.vertices[face[m]]).norm())
+                .fold(0.0, f64::max)
+        })
+        .collect();
     for (vi, &pv) in a.vertices.iter().enumerate() {
         if (0..3).any(|d| pv[d] < lo[d] || pv[d] > hi[d]) {
             continue;
@@ -180,12 +191,9 @@ fn vertex_face(
             // Without it a corner of one block near a corner of another (every joint of a
             // wall of aligned blocks) is seen by neither test, can move into the neighbour
             // unseen within a step, and the next step pushes it out with a burst of energy.
-            let face_edge = (0..face.len())
-                .map(|m| (b.vertices[face[(m + 1) % face.len()]] - b.vertices[face[m]]).norm())
-                .fold(0.0, f64::max);
             let slack = p
                 .inside_tolerance
-                .max(2.0 * p.edge_margin * face_edge.max(vertex_edge));
+                .max(2.0 * p.edge_margin * face_edges[fi].max(vertex_edge));
             let inside = (0..face.len()).all(|m| {
                 let qm = b.vertices[face[m]];
                 let e = b.vertices[face[(m + 1) % face.len()]] - qm;
