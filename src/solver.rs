@@ -832,6 +832,7 @@ impl Solver {
         let dn_max = self.max_step_penetration();
         let close_tol = cp.close_threshold * self.w0;
         let state_tol = cp.open_threshold * self.w0;
+        let warm = cp.warm_start && p.method == Method::Alm;
         let mut d = vec![0.0; 12 * nb];
         let mut oc_passes = 0u32;
         let mut solves = 0u32;
@@ -972,6 +973,36 @@ impl Solver {
                     }
                     c.dn_prev = Some(c.dn);
                 }
+                // A sliding contact whose slip has reversed is in the wrong state: friction
+                // along τ from λ_{k−1} (5.8) is a force the ALM loop does not see coming, and
+                // where friction presses blocks into other contacts (a wedge) the loop λ → friction
+                // → λ can grow without bound (×1.4 an iteration was seen in a struck wall,
+                // reaching metres of displacement within 20 iterations). Such a contact is
+                // locked at once (the open–close check would lock it after the loop, from a
+                // diverged solution), and the loop goes on with the new stiffness.
+                if !settling {
+                    let mut locked = 0;
+                    for c in active.iter_mut() {
+                        if c.rec.state != ContactState::Slide || c.frozen {
+                            continue;
+                        }
+                        let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
+                        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+                        let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
+                        let du = c.ta * di - c.tb(&self.model.blocks) * dj;
+                        if du.dot(&c.rec.tau) < -state_tol {
+                            c.rec.state = ContactState::Lock;
+                            c.rec.reference = c.cand.xb;
+                            c.flips += 1;
+                            locked += 1;
+                        }
+                    }
+                    if locked > 0 {
+                        k_dirty = true;
+                        timings += t1.elapsed();
+                        continue;
+                    }
+                }
                 timings += t1.elapsed();
                 if conv1 && conv2 {
                     alm_converged = true;
@@ -1008,7 +1039,15 @@ impl Solver {
                                 c.rec.state = ContactState::Lock;
                                 c.rec.reference = c.cand.xb;
                                 c.rec.lambda = 0.0;
-                                c.rec.penalty = cp.initial_penalty;
+                                // A new contact starts at p_n,1 (§6.1). One that was closed at
+                                // the start of the step and only opened in an earlier pass is
+                                // not new: it keeps its adapted penalty, which spares the
+                                // (P21) rounds, and their factorizations, of raising it again.
+                                c.rec.penalty = if c.start.state.is_closed() && warm {
+                                    c.start.penalty
+                                } else {
+                                    cp.initial_penalty
+                                };
                                 c.rec.normal_force = 0.0;
                                 changed = true;
                             }
