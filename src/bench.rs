@@ -140,8 +140,8 @@ fn scaling_table(sizes: &[usize], repeat: usize, duration: f64, rock: bool) -> R
         "| N blocks | steps | contacts/step | solves/step | factorizations/step | cuts | wall s | wall s per simulated s | µs per contact-step | ms per factorization |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
-    let (mut ns, mut per_sim_s, mut walls, mut cs) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut ns, mut per_sim_s, mut walls, mut cs, mut cf) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &n in sizes {
         let text = column_wall(n, 5, rock);
         let mut s = scene::parse(&text, &format!("generated wall of {n}"), "wall")
@@ -167,13 +167,29 @@ fn scaling_table(sizes: &[usize], repeat: usize, duration: f64, rock: bool) -> R
         per_sim_s.push(r.wall / r.simulated);
         walls.push(r.wall);
         cs.push(contact_steps);
+        // The work of the iterations: every factorization (and the assembly and bookkeeping
+        // around it) touches every contact once.
+        cf.push(t.contacts_per_step * t.factorizations as f64);
     }
     if ns.len() >= 2 {
         println!(
-            "\nGrowth exponent (least squares on log-log, 1 = linear): wall time per simulated second against N: {:.2}; wall time against contact-steps: {:.2}.",
+            "\nGrowth exponent (least squares on log-log, 1 = linear): wall time per simulated second against N: {:.2}; wall time against contact-steps: {:.2}; wall time against contact-factorizations (contacts × factorizations: the cost of the machinery for the iterations it was asked to do): {:.2}.",
             growth_exponent(&ns, &per_sim_s),
-            growth_exponent(&cs, &walls)
+            growth_exponent(&cs, &walls),
+            growth_exponent(&cf, &walls)
         );
+        let segments: Vec<String> = (1..ns.len())
+            .map(|i| {
+                format!(
+                    "{}→{}: {:.2} against contact-steps, {:.2} against contact-factorizations",
+                    ns[i - 1],
+                    ns[i],
+                    growth_exponent(&cs[i - 1..=i], &walls[i - 1..=i]),
+                    growth_exponent(&cf[i - 1..=i], &walls[i - 1..=i])
+                )
+            })
+            .collect();
+        println!("Between consecutive sizes: {}.", segments.join("; "));
     }
     Ok(())
 }

@@ -186,6 +186,9 @@ struct Active {
     dn: f64,
     force: f64,
     dn_prev: Option<f64>,
+    /// Friction magnitude of a sliding contact whose slip reversed in this pass, held (see
+    /// `iterate`).
+    friction_cap: Option<f64>,
     /// State changes of this contact in the current attempt (to stop open–close cycles).
     flips: u8,
     /// Settled after cycling: no more state changes in this attempt.
@@ -721,6 +724,7 @@ impl Solver {
                     dn: 0.0,
                     force: 0.0,
                     dn_prev: None,
+                    friction_cap: None,
                     flips: 0,
                     frozen: false,
                     changed: false,
@@ -798,7 +802,7 @@ impl Solver {
             ContactState::Slide => {
                 // Friction from the previous iterate's normal force: λ_{k−1} (ALM), p_n d_n (penalty).
                 let n_prev = if alm {
-                    c.rec.lambda
+                    c.rec.lambda.min(c.friction_cap.unwrap_or(f64::INFINITY))
                 } else {
                     c.rec.normal_force.max(0.0)
                 };
@@ -860,6 +864,7 @@ impl Solver {
             let mut k_dirty = true;
             for c in active.iter_mut() {
                 c.dn_prev = None;
+                c.friction_cap = None;
             }
             let mut alm_converged = false;
             for alm_k in 1..=cp.max_alm_iterations {
@@ -973,17 +978,19 @@ impl Solver {
                     }
                     c.dn_prev = Some(c.dn);
                 }
-                // A sliding contact whose slip has reversed is in the wrong state: friction
-                // along τ from λ_{k−1} (5.8) is a force the ALM loop does not see coming, and
-                // where friction presses blocks into other contacts (a wedge) the loop λ → friction
-                // → λ can grow without bound (×1.4 an iteration was seen in a struck wall,
-                // reaching metres of displacement within 20 iterations). Such a contact is
-                // locked at once (the open–close check would lock it after the loop, from a
-                // diverged solution), and the loop goes on with the new stiffness.
+                // A sliding contact whose slip has reversed is in the wrong state, and its
+                // friction, from λ_{k−1} (5.8), can feed back: where friction presses blocks into
+                // other contacts (a wedge) the loop λ → friction → λ grew ×1.4 an iteration in a
+                // struck wall, reaching metres of displacement within 20 iterations, and the
+                // open–close check then classified every contact from that solution. The
+                // friction of such a contact is held at its present value for the rest of the
+                // pass (a change of F only: no refactorization); the open–close check locks it.
                 if !settling {
-                    let mut locked = 0;
                     for c in active.iter_mut() {
-                        if c.rec.state != ContactState::Slide || c.frozen {
+                        if c.rec.state != ContactState::Slide
+                            || c.frozen
+                            || c.friction_cap.is_some()
+                        {
                             continue;
                         }
                         let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
@@ -991,16 +998,8 @@ impl Solver {
                         let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
                         let du = c.ta * di - c.tb(&self.model.blocks) * dj;
                         if du.dot(&c.rec.tau) < -state_tol {
-                            c.rec.state = ContactState::Lock;
-                            c.rec.reference = c.cand.xb;
-                            c.flips += 1;
-                            locked += 1;
+                            c.friction_cap = Some(c.rec.lambda);
                         }
-                    }
-                    if locked > 0 {
-                        k_dirty = true;
-                        timings += t1.elapsed();
-                        continue;
                     }
                 }
                 timings += t1.elapsed();
