@@ -184,8 +184,9 @@ fn column_without_the_rock_stays_put() {
 /// contacts slip through detection and where the open–close iteration churns. A wall of 40 once
 /// gained 1.6× the rock's kinetic energy within 0.1 s of the impact (a corner moved into its
 /// neighbour unseen and was pushed out; a cycling contact settled as sliding pushed its slip).
-/// This wall of 80 gained 0.67 MJ (1.9× the rock's energy) at 0.93 s until sliding contacts whose
-/// slip reversed were locked inside the ALM loop (friction from λ_{k−1} had fed λ back).
+/// This wall of 80 gained 0.67 MJ (1.9× the rock's energy) at 0.93 s until the friction of a
+/// sliding contact whose slip reversed was held for the rest of the ALM loop (friction from
+/// λ_{k−1} had fed λ back through wedged blocks).
 #[test]
 fn generated_wall_struck_by_the_rock_gains_no_energy() {
     let text = dda3d::generate::column_wall(80, 5, true);
