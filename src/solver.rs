@@ -1031,6 +1031,7 @@ impl Solver {
                     continue;
                 }
                 let before = c.rec.state;
+                let mut held = false;
                 'classify: {
                     match c.rec.state {
                         ContactState::Open => {
@@ -1094,6 +1095,11 @@ impl Solver {
                                 // Friction follows the slip direction; it has not reversed here, so
                                 // friction along the old direction still did negative work.
                                 c.rec.tau = c.slip.normalize();
+                                // Friction held (see the ALM loop) below λ tan φ: the contact
+                                // slides on, so the pass is redone with the full friction.
+                                held = c
+                                    .friction_cap
+                                    .is_some_and(|cap| cap < (1.0 - cp.eps2) * c.rec.lambda);
                             }
                         }
                     }
@@ -1114,7 +1120,8 @@ impl Solver {
                         c.cand.key.j
                     );
                 }
-                if c.rec.state != before {
+                changed |= held;
+                if c.rec.state != before || held {
                     c.changed = true;
                     c.flips += 1;
                     if c.flips > MAX_FLIPS {
