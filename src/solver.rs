@@ -800,7 +800,9 @@ impl Solver {
                 add_shear_spring(&mut t, &c.ta, &tb, &c.cand.normal, &delta, p_tau, with_k);
             }
             ContactState::Slide => {
-                // Friction from the previous iterate's normal force: λ_{k−1} (ALM), p_n d_n (penalty).
+                // Friction from the previous iterate's normal force: λ_{k−1} (ALM), p_n d_n
+                // (penalty); held for the rest of the ALM loop once the slip has reversed (see
+                // `iterate`).
                 let n_prev = if alm {
                     c.rec.lambda.min(c.friction_cap.unwrap_or(f64::INFINITY))
                 } else {
@@ -1031,7 +1033,6 @@ impl Solver {
                     continue;
                 }
                 let before = c.rec.state;
-                let mut held = false;
                 'classify: {
                     match c.rec.state {
                         ContactState::Open => {
@@ -1086,8 +1087,14 @@ impl Solver {
                                 }
                             } else if c.slip.dot(&c.rec.tau) < -state_tol
                                 || c.slip.norm() < state_tol
+                                || c.friction_cap
+                                    .is_some_and(|cap| cap < (1.0 - cp.eps2) * c.rec.lambda)
                             {
-                                // The slip reversed, or stopped: the contact sticks again.
+                                // The slip reversed, or stopped: the contact sticks again. So
+                                // does a contact whose friction was held (see the ALM loop) below
+                                // its capacity λ tan φ: the slip reversed under a smaller friction
+                                // and goes forward under the held one, so a friction within the
+                                // capacity stops it.
                                 c.rec.state = ContactState::Lock;
                                 c.rec.reference = c.cand.xb;
                                 changed = true;
@@ -1095,11 +1102,6 @@ impl Solver {
                                 // Friction follows the slip direction; it has not reversed here, so
                                 // friction along the old direction still did negative work.
                                 c.rec.tau = c.slip.normalize();
-                                // Friction held (see the ALM loop) below λ tan φ: the contact
-                                // slides on, so the pass is redone with the full friction.
-                                held = c
-                                    .friction_cap
-                                    .is_some_and(|cap| cap < (1.0 - cp.eps2) * c.rec.lambda);
                             }
                         }
                     }
@@ -1120,8 +1122,7 @@ impl Solver {
                         c.cand.key.j
                     );
                 }
-                changed |= held;
-                if c.rec.state != before || held {
+                if c.rec.state != before {
                     c.changed = true;
                     c.flips += 1;
                     if c.flips > MAX_FLIPS {
