@@ -217,6 +217,14 @@ impl Active {
         }
     }
 
+    /// Δu_ab = T_a D_i − T_b D_j (reference §6.1) for the solution `d`.
+    fn relative_displacement(&self, d: &[f64], blocks: &[Block]) -> Vec3 {
+        let (i, j) = (self.cand.key.i as usize, self.cand.key.j as usize);
+        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+        let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
+        self.ta * di - self.tb(blocks) * dj
+    }
+
     fn tb(&self, blocks: &[Block]) -> Mat3x12 {
         let j = &blocks[self.cand.key.j as usize];
         let xb = match self.rec.state {
@@ -995,10 +1003,7 @@ impl Solver {
                         {
                             continue;
                         }
-                        let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
-                        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
-                        let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
-                        let du = c.ta * di - c.tb(&self.model.blocks) * dj;
+                        let du = c.relative_displacement(&d, &self.model.blocks);
                         if du.dot(&c.rec.tau) < -state_tol {
                             c.friction_cap = Some(c.rec.lambda);
                         }
@@ -1021,12 +1026,8 @@ impl Solver {
             let mut changed = false;
             for c in active.iter_mut() {
                 c.changed = false;
-                let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
-                let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
-                let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
-                let tb = c.tb(&self.model.blocks);
                 let n = c.cand.normal;
-                let du = c.ta * di - tb * dj;
+                let du = c.relative_displacement(&d, &self.model.blocks);
                 c.slip = du - n * n.dot(&du);
                 if c.frozen {
                     c.rec.normal_force = c.force;
