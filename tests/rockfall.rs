@@ -179,8 +179,8 @@ fn column_without_the_rock_stays_put() {
     assert!(o.max_penetration < 1e-5);
 }
 
-/// A wall of 80 blocks (16 columns of 5) struck by the rock, through the impact and 1.3 s of
-/// collapse: the joints between columns, and the corners where four blocks meet, are where
+/// A wall of 80 blocks (16 columns of 5) struck by the rock, through the impact and the 1.3 s of
+/// motion after it: the joints between columns, and the corners where four blocks meet, are where
 /// contacts slip through detection and where the open–close iteration churns. A wall of 40 once
 /// gained 1.6× the rock's kinetic energy within 0.1 s of the impact (a corner moved into its
 /// neighbour unseen and was pushed out; a cycling contact settled as sliding pushed its slip).
