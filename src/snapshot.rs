@@ -68,6 +68,39 @@ pub struct BlockSnapshot {
     pub displacement: [f64; 3],
 }
 
+#[cfg(test)]
+impl BlockSnapshot {
+    /// Test fixture: an axis-aligned cube of edge `size` with its lowest corner at `at`, at rest.
+    pub(crate) fn test_cube(name: &str, at: [f64; 3], size: f64) -> Self {
+        let vertices = (0..8)
+            .map(|i| {
+                [
+                    at[0] + size * (i & 1) as f64,
+                    at[1] + size * ((i >> 1) & 1) as f64,
+                    at[2] + size * ((i >> 2) & 1) as f64,
+                ]
+            })
+            .collect();
+        let faces = vec![
+            vec![0, 2, 3, 1],
+            vec![4, 5, 7, 6],
+            vec![0, 1, 5, 4],
+            vec![1, 3, 7, 5],
+            vec![3, 2, 6, 7],
+            vec![2, 0, 4, 6],
+        ];
+        BlockSnapshot {
+            name: name.into(),
+            fixed: false,
+            vertices,
+            faces,
+            centroid: at.map(|x| x + size / 2.0),
+            velocity: [0.0; 3],
+            displacement: [0.0; 3],
+        }
+    }
+}
+
 /// One active (non-open) contact at the end of a step.
 #[derive(Clone, Debug, Serialize)]
 pub struct ContactSnapshot {

@@ -418,31 +418,11 @@ mod tests {
     use crate::snapshot::*;
 
     fn cube(name: &str, at: [f64; 3], fixed: bool) -> BlockSnapshot {
-        let v: Vec<[f64; 3]> = (0..8)
-            .map(|i| {
-                [
-                    at[0] + (i & 1) as f64,
-                    at[1] + ((i >> 1) & 1) as f64,
-                    at[2] + ((i >> 2) & 1) as f64,
-                ]
-            })
-            .collect();
-        let faces = vec![
-            vec![0, 2, 3, 1],
-            vec![4, 5, 7, 6],
-            vec![0, 1, 5, 4],
-            vec![1, 3, 7, 5],
-            vec![3, 2, 6, 7],
-            vec![2, 0, 4, 6],
-        ];
         BlockSnapshot {
-            name: name.into(),
             fixed,
-            vertices: v,
-            faces,
-            centroid: [at[0] + 0.5, at[1] + 0.5, at[2] + 0.5],
             velocity: [0.0, 0.0, -2.0],
             displacement: [0.0, 0.0, -0.5],
+            ..BlockSnapshot::test_cube(name, at, 1.0)
         }
     }
 

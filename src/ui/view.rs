@@ -216,33 +216,7 @@ mod tests {
     use crate::snapshot::{Snapshot, StepStats};
 
     fn cube(name: &str, at: [f64; 3], size: f64) -> BlockSnapshot {
-        let v: Vec<[f64; 3]> = (0..8)
-            .map(|i| {
-                [
-                    at[0] + size * (i & 1) as f64,
-                    at[1] + size * ((i >> 1) & 1) as f64,
-                    at[2] + size * ((i >> 2) & 1) as f64,
-                ]
-            })
-            .collect();
-        let faces = vec![
-            vec![0, 2, 3, 1],
-            vec![4, 5, 7, 6],
-            vec![0, 1, 5, 4],
-            vec![1, 3, 7, 5],
-            vec![3, 2, 6, 7],
-            vec![2, 0, 4, 6],
-        ];
-        let c = [at[0] + size / 2.0, at[1] + size / 2.0, at[2] + size / 2.0];
-        BlockSnapshot {
-            name: name.into(),
-            fixed: false,
-            vertices: v,
-            faces,
-            centroid: c,
-            velocity: [0.0; 3],
-            displacement: [0.0; 3],
-        }
+        BlockSnapshot::test_cube(name, at, size)
     }
 
     fn snap(blocks: Vec<BlockSnapshot>) -> Snapshot {
