@@ -8,6 +8,17 @@ fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_dda3d"))
 }
 
+/// `dda3d run SCENE --out OUT`, its output captured.
+fn run_scene(scene: &Path, out: &Path) -> std::process::Output {
+    bin()
+        .arg("run")
+        .arg(scene)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
 }
@@ -77,13 +88,7 @@ fn expect_input_error(text: &str, needle: &str) {
     let dir = tmp("bad");
     let path = dir.join("bad.toml");
     std::fs::write(&path, text).unwrap();
-    let out = bin()
-        .arg("run")
-        .arg(&path)
-        .arg("--out")
-        .arg(dir.join("o"))
-        .output()
-        .unwrap();
+    let out = run_scene(&path, &dir.join("o"));
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "stderr: {err}");
     assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
@@ -180,13 +185,7 @@ fn diverging_run_keeps_its_output() {
         ),
     )
     .unwrap();
-    let out = bin()
-        .arg("run")
-        .arg(&path)
-        .arg("--out")
-        .arg(dir.join("o"))
-        .output()
-        .unwrap();
+    let out = run_scene(&path, &dir.join("o"));
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{err}");
     assert!(
