@@ -236,6 +236,26 @@ impl EguiPainter {
         })
     }
 
+    /// Keeps an egui-owned texture under `id` with a bind group for its sampling options.
+    fn insert_texture(
+        &mut self,
+        device: &wgpu::Device,
+        id: TextureId,
+        tex: &wgpu::Texture,
+        options: epaint::textures::TextureOptions,
+    ) {
+        let view = tex.create_view(&Default::default());
+        let bind_group = self.bind_group(device, &view, options);
+        self.textures.insert(
+            id,
+            Texture {
+                texture: Some(tex.clone()),
+                bind_group,
+                options: Some(options),
+            },
+        );
+    }
+
     fn bind_group(
         &mut self,
         device: &wgpu::Device,
@@ -326,16 +346,7 @@ impl EguiPainter {
         let texture = match (delta.pos, existing) {
             (Some(_), Some((tex, options))) => {
                 if options != Some(delta.options) {
-                    let view = tex.create_view(&Default::default());
-                    let bind_group = self.bind_group(device, &view, delta.options);
-                    self.textures.insert(
-                        id,
-                        Texture {
-                            texture: Some(tex.clone()),
-                            bind_group,
-                            options: Some(delta.options),
-                        },
-                    );
+                    self.insert_texture(device, id, &tex, delta.options);
                 }
                 tex
             }
@@ -352,16 +363,7 @@ impl EguiPainter {
                     usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
                     view_formats: &[],
                 });
-                let view = tex.create_view(&Default::default());
-                let bind_group = self.bind_group(device, &view, delta.options);
-                self.textures.insert(
-                    id,
-                    Texture {
-                        texture: Some(tex.clone()),
-                        bind_group,
-                        options: Some(delta.options),
-                    },
-                );
+                self.insert_texture(device, id, &tex, delta.options);
                 tex
             }
         };
