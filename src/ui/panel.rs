@@ -1422,6 +1422,13 @@ fn plot_title(ui: &mut egui::Ui, title: &str, tip: &str) {
         .on_hover_text(tip);
 }
 
+/// A dashed grey line marking a limit (a tolerance or a cap) on a plot.
+fn limit_line(name: &str, y: f64) -> HLine {
+    HLine::new(name, y)
+        .style(LineStyle::dashed_loose())
+        .color(Color32::from_gray(110))
+}
+
 fn small_plot<'a>(id: &str, height: f32) -> Plot<'a> {
     Plot::new(id)
         .height(height)
@@ -1474,11 +1481,7 @@ fn plots(ui: &mut egui::Ui, state: &mut UiState) {
                 && pr.method == Method::Alm
                 && dn_max > 0.0
             {
-                p.hline(
-                    HLine::new("ε1·d_n,max", pr.contact.eps1 * dn_max * 1e3)
-                        .style(LineStyle::dashed_loose())
-                        .color(Color32::from_gray(110)),
-                );
+                p.hline(limit_line("ε1·d_n,max", pr.contact.eps1 * dn_max * 1e3));
             }
         });
 
@@ -1543,11 +1546,7 @@ fn plots(ui: &mut egui::Ui, state: &mut UiState) {
                 if let Some(pr) = &params
                     && pr.method == Method::Alm
                 {
-                    p.hline(
-                        HLine::new("γ·E", pr.contact.gamma.log10())
-                            .style(LineStyle::dashed_loose())
-                            .color(Color32::from_gray(110)),
-                    );
+                    p.hline(limit_line("γ·E", pr.contact.gamma.log10()));
                 }
             });
 
