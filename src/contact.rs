@@ -429,57 +429,72 @@ pub fn normal_kinematics(
     }
 }
 
-/// Stiffness and force contributions of one contact to the blocks i and j.
+/// Stiffness contributions of one contact to the blocks i and j. Kept apart from the forces:
+/// the ALM iterations that only update λ rebuild the forces alone, and zeroing and moving these
+/// three 12×12 blocks for every contact of every iteration cost more than the forces themselves.
 #[derive(Clone, Debug, Default)]
-pub struct ContactTerms {
+pub struct ContactStiffness {
     pub k_ii: Mat12,
     pub k_ij: Mat12,
     pub k_jj: Mat12,
+}
+
+/// Force contributions of one contact to the blocks i and j.
+#[derive(Clone, Debug, Default)]
+pub struct ContactForces {
     pub f_i: Vec12,
     pub f_j: Vec12,
 }
 
 /// Normal stiffness of a closed contact, (P10a)–(P10d).
-pub fn add_normal_stiffness(t: &mut ContactTerms, k: &NormalKinematics, penalty: f64) {
+pub fn add_normal_stiffness(t: &mut ContactStiffness, k: &NormalKinematics, penalty: f64) {
     t.k_ii += k.g_i * k.g_i.transpose() * penalty;
     t.k_ij += k.g_i * k.g_j.transpose() * penalty;
     t.k_jj += k.g_j * k.g_j.transpose() * penalty;
 }
 
 /// Normal force terms of a closed contact, (P10e)–(P10f): −(λ_{k−1} + p_n d0) G.
-pub fn add_normal_force(t: &mut ContactTerms, k: &NormalKinematics, penalty: f64, lambda: f64) {
+pub fn add_normal_force(t: &mut ContactForces, k: &NormalKinematics, penalty: f64, lambda: f64) {
     let s = lambda + penalty * k.d0;
     t.f_i -= k.g_i * s;
     t.f_j -= k.g_j * s;
 }
 
 /// Tangential spring of a locked contact, (P15) as corrected in (5.7): the potential
-/// ½ p_τ rᵀ N r with r = Δ + T_a D_i − T_b D_j and N = I − n nᵀ.
-pub fn add_shear_spring(
-    t: &mut ContactTerms,
+/// ½ p_τ rᵀ N r with r = Δ + T_a D_i − T_b D_j and N = I − n nᵀ. Its stiffness:
+pub fn add_shear_spring_stiffness(
+    t: &mut ContactStiffness,
+    ta: &Mat3x12,
+    tb: &Mat3x12,
+    n: &Vec3,
+    p_tau: f64,
+) {
+    let proj = nalgebra::Matrix3::identity() - n * n.transpose();
+    let nta = proj * ta;
+    let ntb = proj * tb;
+    t.k_ii += ta.transpose() * nta * p_tau;
+    t.k_ij -= ta.transpose() * ntb * p_tau;
+    t.k_jj += tb.transpose() * ntb * p_tau;
+}
+
+/// The force of the tangential spring of [`add_shear_spring_stiffness`] at D = 0:
+/// −p_τ T_aᵀ N Δ on i and +p_τ T_bᵀ N Δ on j.
+pub fn add_shear_spring_force(
+    t: &mut ContactForces,
     ta: &Mat3x12,
     tb: &Mat3x12,
     n: &Vec3,
     delta: &Vec3,
     p_tau: f64,
-    with_stiffness: bool,
 ) {
-    let proj = nalgebra::Matrix3::identity() - n * n.transpose();
-    let nta = proj * ta;
-    let ntb = proj * tb;
-    if with_stiffness {
-        t.k_ii += ta.transpose() * nta * p_tau;
-        t.k_ij -= ta.transpose() * ntb * p_tau;
-        t.k_jj += tb.transpose() * ntb * p_tau;
-    }
-    let nd = proj * delta;
-    t.f_i -= ta.transpose() * nd * p_tau;
-    t.f_j += tb.transpose() * nd * p_tau;
+    let nd = (delta - n * n.dot(delta)) * p_tau;
+    t.f_i -= ta.transpose() * nd;
+    t.f_j += tb.transpose() * nd;
 }
 
 /// Sliding friction (P20): a force of magnitude `friction` opposing the slip direction τ of
 /// point a relative to point b. Loads only; the stiffness stays symmetric.
-pub fn add_friction(t: &mut ContactTerms, ta: &Mat3x12, tb: &Mat3x12, tau: &Vec3, friction: f64) {
+pub fn add_friction(t: &mut ContactForces, ta: &Mat3x12, tb: &Mat3x12, tau: &Vec3, friction: f64) {
     t.f_i -= ta.transpose() * tau * friction;
     t.f_j += tb.transpose() * tau * friction;
 }
@@ -729,11 +744,13 @@ mod tests {
         let delta = xa - xb;
         let tau = (r * Vec3::new(0.6, 0.8, 0.0)).normalize();
         let (p_tau, fric) = (1.2e8, 7.0e3);
-        let mut t = ContactTerms::default();
+        let mut t = ContactStiffness::default();
         add_normal_stiffness(&mut t, &k, p);
-        add_normal_force(&mut t, &k, p, lambda);
-        add_shear_spring(&mut t, &ta, &tb, &n, &delta, p_tau, true);
-        add_friction(&mut t, &ta, &tb, &tau, fric);
+        add_shear_spring_stiffness(&mut t, &ta, &tb, &n, p_tau);
+        let mut f = ContactForces::default();
+        add_normal_force(&mut f, &k, p, lambda);
+        add_shear_spring_force(&mut f, &ta, &tb, &n, &delta, p_tau);
+        add_friction(&mut f, &ta, &tb, &tau, fric);
         let proj = Mat3::identity() - n * n.transpose();
         let potential = |d: &[f64; 24]| {
             let di = Vec12::from_column_slice(&d[..12]);
@@ -758,7 +775,7 @@ mod tests {
             })
         };
         let g0 = grad(&z);
-        let f: Vec<f64> = t.f_i.iter().chain(t.f_j.iter()).copied().collect();
+        let f: Vec<f64> = f.f_i.iter().chain(f.f_j.iter()).copied().collect();
         for a in 0..24 {
             assert!(
                 (g0[a] + f[a]).abs() < 1e-6 * f.iter().map(|x| x.abs()).fold(0.0, f64::max),

@@ -9,9 +9,10 @@ use std::time::{Duration, Instant};
 use nalgebra::{Matrix6, Vector6};
 
 use crate::contact::{
-    Candidate, ContactKey, ContactState, ContactTerms, DetectionParams, NormalKinematics, Shape,
-    add_friction, add_normal_force, add_normal_stiffness, add_shear_spring, broad_phase,
-    detect_pair, normal_kinematics, planar_hull_area,
+    Candidate, ContactForces, ContactKey, ContactState, ContactStiffness, DetectionParams,
+    NormalKinematics, Shape, add_friction, add_normal_force, add_normal_stiffness,
+    add_shear_spring_force, add_shear_spring_stiffness, broad_phase, detect_pair,
+    normal_kinematics, planar_hull_area,
 };
 use crate::geometry::{
     MassProperties, Topology, Vec3, bounding_box, mass_properties, newell_normal,
@@ -784,15 +785,29 @@ impl Solver {
         (k0, f0)
     }
 
-    /// The stiffness (when `with_k`) and force terms of one closed contact in its current state:
-    /// normal (P10), locked shear spring (P15)/(5.7), or sliding friction (P20).
-    fn contact_terms(&self, c: &Active, with_k: bool) -> ContactTerms {
-        let p = &self.params;
-        let cp = &p.contact;
-        let mut t = ContactTerms::default();
-        if with_k {
-            add_normal_stiffness(&mut t, &c.kin, c.rec.penalty);
+    /// The stiffness of one closed contact in its current state: normal (P10), and the shear
+    /// spring (P15)/(5.7) if locked (sliding friction (P20) adds loads only).
+    fn contact_stiffness(&self, c: &Active) -> ContactStiffness {
+        let mut t = ContactStiffness::default();
+        add_normal_stiffness(&mut t, &c.kin, c.rec.penalty);
+        if c.rec.state == ContactState::Lock {
+            let p_tau = self.params.contact.shear_penalty(c.rec.penalty);
+            add_shear_spring_stiffness(
+                &mut t,
+                &c.ta,
+                &c.tb(&self.model.blocks),
+                &c.cand.normal,
+                p_tau,
+            );
         }
+        t
+    }
+
+    /// The force terms of one closed contact in its current state: normal (P10), locked shear
+    /// spring (P15)/(5.7), or sliding friction (P20).
+    fn contact_forces(&self, c: &Active) -> ContactForces {
+        let p = &self.params;
+        let mut t = ContactForces::default();
         let alm = p.method == Method::Alm;
         add_normal_force(
             &mut t,
@@ -804,8 +819,8 @@ impl Solver {
         match c.rec.state {
             ContactState::Lock => {
                 let delta = c.cand.xa - c.rec.reference;
-                let p_tau = cp.shear_penalty(c.rec.penalty);
-                add_shear_spring(&mut t, &c.ta, &tb, &c.cand.normal, &delta, p_tau, with_k);
+                let p_tau = p.contact.shear_penalty(c.rec.penalty);
+                add_shear_spring_force(&mut t, &c.ta, &tb, &c.cand.normal, &delta, p_tau);
             }
             ContactState::Slide => {
                 // Friction from the previous iterate's normal force: λ_{k−1} (ALM), p_n d_n
@@ -892,13 +907,14 @@ impl Solver {
                     if c.rec.state == ContactState::Open {
                         continue;
                     }
-                    let t = self.contact_terms(c, k_dirty);
                     let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
                     if k_dirty {
+                        let t = self.contact_stiffness(c);
                         kmat.diag[i] += t.k_ii;
                         kmat.diag[j] += t.k_jj;
                         kmat.add_off(c.pair, i, j, &t.k_ij);
                     }
+                    let t = self.contact_forces(c);
                     for a in 0..12 {
                         f[12 * i + a] += t.f_i[a];
                         f[12 * j + a] += t.f_j[a];
@@ -1386,7 +1402,7 @@ mod tests {
         let (k0, _) = solver.block_terms(0.01);
         k.diag.copy_from_slice(&k0);
         for c in &active {
-            let t = solver.contact_terms(c, true);
+            let t = solver.contact_stiffness(c);
             let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
             k.diag[i] += t.k_ii;
             k.diag[j] += t.k_jj;
