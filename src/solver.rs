@@ -218,6 +218,24 @@ impl Active {
         }
     }
 
+    /// What this contact's stiffness depends on within an attempt (its kinematics are frozen):
+    /// nothing if open; p_n if sliding; p_n and the reference point of the shear spring if locked.
+    fn stiffness_key(&self) -> Option<StiffnessKey> {
+        match self.rec.state {
+            ContactState::Open => None,
+            ContactState::Slide => Some(StiffnessKey {
+                lock: false,
+                penalty: self.rec.penalty,
+                reference: Vec3::zeros(),
+            }),
+            ContactState::Lock => Some(StiffnessKey {
+                lock: true,
+                penalty: self.rec.penalty,
+                reference: self.rec.reference,
+            }),
+        }
+    }
+
     /// Δu_ab = T_a D_i − T_b D_j (reference §6.1) for the solution `d`.
     fn relative_displacement(&self, d: &[f64], blocks: &[Block]) -> Vec3 {
         let (i, j) = (self.cand.key.i as usize, self.cand.key.j as usize);
@@ -234,6 +252,14 @@ impl Active {
         };
         displacement_matrix(&(xb - j.mp.centroid))
     }
+}
+
+/// See [`Active::stiffness_key`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct StiffnessKey {
+    lock: bool,
+    penalty: f64,
+    reference: Vec3,
 }
 
 /// A run that cannot go on.
@@ -794,22 +820,27 @@ impl Solver {
         (k0, f0)
     }
 
-    /// The stiffness of one closed contact in its current state: normal (P10), and the shear
-    /// spring (P15)/(5.7) if locked (sliding friction (P20) adds loads only).
-    fn contact_stiffness(&self, c: &Active) -> ContactStiffness {
+    /// The stiffness of one closed contact in the state `key`: normal (P10), and the shear spring
+    /// (P15)/(5.7) if locked (sliding friction (P20) adds loads only).
+    fn contact_stiffness(&self, c: &Active, key: &StiffnessKey) -> ContactStiffness {
         let mut t = ContactStiffness::default();
-        add_normal_stiffness(&mut t, &c.kin, c.rec.penalty);
-        if c.rec.state == ContactState::Lock {
-            let p_tau = self.params.contact.shear_penalty(c.rec.penalty);
-            add_shear_spring_stiffness(
-                &mut t,
-                &c.ta,
-                &c.tb(&self.model.blocks),
-                &c.cand.normal,
-                p_tau,
-            );
+        add_normal_stiffness(&mut t, &c.kin, key.penalty);
+        if key.lock {
+            let j = &self.model.blocks[c.cand.key.j as usize];
+            let tb = displacement_matrix(&(key.reference - j.mp.centroid));
+            let p_tau = self.params.contact.shear_penalty(key.penalty);
+            add_shear_spring_stiffness(&mut t, &c.ta, &tb, &c.cand.normal, p_tau);
         }
         t
+    }
+
+    /// Adds (`sign` = 1) or removes (−1) the stiffness of contact `c` in the state `key`.
+    fn apply_stiffness(&self, kmat: &mut BlockMatrix, c: &Active, key: &StiffnessKey, sign: f64) {
+        let t = self.contact_stiffness(c, key);
+        let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
+        kmat.diag[i] += t.k_ii * sign;
+        kmat.diag[j] += t.k_jj * sign;
+        kmat.add_off(c.pair, i, j, &(t.k_ij * sign));
     }
 
     /// The force terms of one closed contact in its current state: normal (P10), locked shear
@@ -883,6 +914,8 @@ impl Solver {
         // contacts that still changed settled closed and locked, and the step is accepted. So
         // also where the stragglers are few (see `SETTLE_FRACTION`).
         let mut settling = false;
+        // The state each contact's stiffness is in K with; empty until K is first assembled.
+        let mut in_k: Vec<Option<StiffnessKey>> = Vec::new();
         for oc_idx in 0..=cp.max_open_close_iterations {
             if oc_idx == cp.max_open_close_iterations {
                 let stragglers = active.iter().filter(|c| c.changed).count() as f64;
@@ -906,11 +939,31 @@ impl Solver {
             for alm_k in 1..=cp.max_alm_iterations {
                 let t0 = Instant::now();
                 if k_dirty {
-                    for (i, kd) in kmat.diag.iter_mut().enumerate() {
-                        *kd = k0[i];
+                    // K is updated, not rebuilt: only the contacts whose state, penalty or
+                    // shear-spring reference changed since the last assembly swap their old
+                    // stiffness for the new one. Rebuilding all of them at every state change
+                    // or penalty raise took a fifth of a struck 100-block wall's run.
+                    if in_k.is_empty() {
+                        for (kd, k) in kmat.diag.iter_mut().zip(&k0) {
+                            *kd = *k;
+                        }
+                        for o in kmat.off.iter_mut() {
+                            *o = Mat12::zeros();
+                        }
+                        in_k = vec![None; active.len()];
                     }
-                    for o in kmat.off.iter_mut() {
-                        *o = Mat12::zeros();
+                    for (c, slot) in active.iter().zip(in_k.iter_mut()) {
+                        let want = c.stiffness_key();
+                        if *slot == want {
+                            continue;
+                        }
+                        if let Some(old) = slot {
+                            self.apply_stiffness(kmat, c, old, -1.0);
+                        }
+                        if let Some(new) = &want {
+                            self.apply_stiffness(kmat, c, new, 1.0);
+                        }
+                        *slot = want;
                     }
                 }
                 let mut f: Vec<f64> = f0.iter().flat_map(|v| v.iter().copied()).collect();
@@ -919,12 +972,6 @@ impl Solver {
                         continue;
                     }
                     let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
-                    if k_dirty {
-                        let t = self.contact_stiffness(c);
-                        kmat.diag[i] += t.k_ii;
-                        kmat.diag[j] += t.k_jj;
-                        kmat.add_off(c.pair, i, j, &t.k_ij);
-                    }
                     let t = self.contact_forces(c);
                     for a in 0..12 {
                         f[12 * i + a] += t.f_i[a];
@@ -1413,11 +1460,9 @@ mod tests {
         let (k0, _) = solver.block_terms(0.01);
         k.diag.copy_from_slice(&k0);
         for c in &active {
-            let t = solver.contact_stiffness(c);
-            let (i, j) = (c.cand.key.i as usize, c.cand.key.j as usize);
-            k.diag[i] += t.k_ii;
-            k.diag[j] += t.k_jj;
-            k.add_off(c.pair, i, j, &t.k_ij);
+            if let Some(key) = c.stiffness_key() {
+                solver.apply_stiffness(&mut k, c, &key, 1.0);
+            }
         }
         let n = 12 * solver.model.blocks.len();
         let mut dense = nalgebra::DMatrix::<f64>::zeros(n, n);
@@ -1443,5 +1488,81 @@ mod tests {
             rn < 1e-6 * b.iter().map(|v| v * v).sum::<f64>().sqrt(),
             "residual {rn:e}"
         );
+    }
+
+    /// K updated contact by contact (the old stiffness of each changed contact out, the new one
+    /// in, as `iterate` does after state changes and penalty raises) equals K assembled afresh.
+    #[test]
+    fn updated_matrix_equals_fresh_assembly() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes/rock_column_rockfall.toml");
+        let s = crate::scene::load(&path).unwrap();
+        let mut solver = Solver::new(s.model, s.params);
+        while solver.time < 0.25 {
+            solver.step().unwrap();
+        }
+        let (mut active, _) = solver.activate();
+        let pairs: Vec<(usize, usize)> = active
+            .iter()
+            .map(|c| (c.cand.key.i as usize, c.cand.key.j as usize))
+            .collect();
+        let fresh = |active: &[Active]| {
+            let mut k = BlockMatrix::new(solver.model.blocks.len(), pairs.clone());
+            let (k0, _) = solver.block_terms(0.01);
+            k.diag.copy_from_slice(&k0);
+            for c in active {
+                if let Some(key) = c.stiffness_key() {
+                    solver.apply_stiffness(&mut k, c, &key, 1.0);
+                }
+            }
+            k
+        };
+        let pattern = BlockMatrix::new(solver.model.blocks.len(), pairs.clone());
+        for c in active.iter_mut() {
+            c.pair = pattern
+                .pair_index(c.cand.key.i as usize, c.cand.key.j as usize)
+                .unwrap();
+            c.rec.state = ContactState::Lock;
+        }
+        let mut k = fresh(&active);
+        let keys: Vec<_> = active.iter().map(|c| c.stiffness_key()).collect();
+        // Every contact changes: opened, set sliding, stiffened ×1000, or its spring re-anchored.
+        for (n, c) in active.iter_mut().enumerate() {
+            match n % 4 {
+                0 => c.rec.state = ContactState::Open,
+                1 => c.rec.state = ContactState::Slide,
+                2 => c.rec.penalty *= 1000.0,
+                _ => c.rec.reference += Vec3::new(1e-3, -2e-3, 5e-4),
+            }
+        }
+        for (c, old) in active.iter().zip(&keys) {
+            let new = c.stiffness_key();
+            assert_ne!(&new, old);
+            if let Some(old) = old {
+                solver.apply_stiffness(&mut k, c, old, -1.0);
+            }
+            if let Some(new) = &new {
+                solver.apply_stiffness(&mut k, c, new, 1.0);
+            }
+        }
+        let want = fresh(&active);
+        let scale = want
+            .diag
+            .iter()
+            .chain(&want.off)
+            .map(|m| m.abs().max())
+            .fold(0.0, f64::max);
+        for (a, b) in k
+            .diag
+            .iter()
+            .chain(&k.off)
+            .zip(want.diag.iter().chain(&want.off))
+        {
+            assert!(
+                (a - b).abs().max() <= 1e-13 * scale,
+                "{:e}",
+                (a - b).abs().max()
+            );
+        }
     }
 }
