@@ -151,7 +151,8 @@ pub struct Summary {
     pub contacts_per_step: f64,
     pub unconverged_steps: u64,
     pub alm_cap_hits: u64,
-    /// Contacts settled after cycling between states within one attempt, or at the Δt floor.
+    /// Contacts settled after cycling between states within one attempt, or at the open–close
+    /// pass limit.
     pub frozen_contacts: u64,
     /// Seconds spent in each phase.
     pub timings: Timings,

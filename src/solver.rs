@@ -298,7 +298,7 @@ pub struct RunTotals {
     /// ALM loops that hit the iteration cap.
     pub alm_cap_hits: u64,
     /// Contacts settled closed and locked: after cycling between states within one attempt, or
-    /// still changing at the open–close pass limit at the Δt floor.
+    /// still changing at the open–close pass limit (see `unconverged_steps`).
     pub frozen_contacts: u64,
     pub contacts_per_step: f64,
     pub timings: Timings,
