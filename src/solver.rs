@@ -1409,20 +1409,30 @@ mod tests {
     use super::*;
     use crate::snapshot::ContactMode;
 
+    /// The rockfall column run into the impact (0.25 s), where vertex–face and edge–edge contacts
+    /// are active: the solver, its contacts for the next step, and their block pairs.
+    fn at_impact() -> (Solver, Vec<Active>, Vec<(usize, usize)>) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes/rock_column_rockfall.toml");
+        let s = crate::scene::load(&path).unwrap();
+        let mut solver = Solver::new(s.model, s.params);
+        while solver.time < 0.25 {
+            solver.step().unwrap();
+        }
+        let (active, _) = solver.activate();
+        let pairs = active
+            .iter()
+            .map(|c| (c.cand.key.i as usize, c.cand.key.j as usize))
+            .collect();
+        (solver, active, pairs)
+    }
+
     /// The assembled global matrix — block terms, fixed-point springs, and contacts in all three
     /// closed configurations (normal + shear spring, normal + friction) of both entrance modes —
     /// is symmetric and positive definite (reference §7), so Cholesky applies.
     #[test]
     fn assembled_matrix_is_symmetric_positive_definite() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scenes/rock_column_rockfall.toml");
-        let s = crate::scene::load(&path).unwrap();
-        let mut solver = Solver::new(s.model, s.params);
-        // Run into the impact, where vertex–face and edge–edge contacts are active.
-        while solver.time < 0.25 {
-            solver.step().unwrap();
-        }
-        let (mut active, _) = solver.activate();
+        let (solver, mut active, pairs) = at_impact();
         assert!(
             active
                 .iter()
@@ -1433,10 +1443,6 @@ mod tests {
                 .iter()
                 .any(|c| c.cand.mode() == ContactMode::VertexFace)
         );
-        let pairs: Vec<(usize, usize)> = active
-            .iter()
-            .map(|c| (c.cand.key.i as usize, c.cand.key.j as usize))
-            .collect();
         let mut k = BlockMatrix::new(solver.model.blocks.len(), pairs);
         // Alternate the states so that both closed variants are assembled; raise some penalties.
         for (n, c) in active.iter_mut().enumerate() {
@@ -1494,18 +1500,7 @@ mod tests {
     /// in, as `iterate` does after state changes and penalty raises) equals K assembled afresh.
     #[test]
     fn updated_matrix_equals_fresh_assembly() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scenes/rock_column_rockfall.toml");
-        let s = crate::scene::load(&path).unwrap();
-        let mut solver = Solver::new(s.model, s.params);
-        while solver.time < 0.25 {
-            solver.step().unwrap();
-        }
-        let (mut active, _) = solver.activate();
-        let pairs: Vec<(usize, usize)> = active
-            .iter()
-            .map(|c| (c.cand.key.i as usize, c.cand.key.j as usize))
-            .collect();
+        let (solver, mut active, pairs) = at_impact();
         let fresh = |active: &[Active]| {
             let mut k = BlockMatrix::new(solver.model.blocks.len(), pairs.clone());
             let (k0, _) = solver.block_terms(0.01);
