@@ -392,7 +392,9 @@ mod tests {
                     }
                 }
             }
-            pairs.push((0, id(z % w, 0)));
+        }
+        for x in 0..w {
+            pairs.push((0, id(x, 0)));
         }
         let nb = 1 + w * h;
         let mut k = BlockMatrix::new(nb, pairs);
