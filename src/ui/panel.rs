@@ -1080,7 +1080,7 @@ fn solver_section(ui: &mut egui::Ui, state: &mut UiState) {
                     param_label(
                         ui,
                         "Open–close passes",
-                        "Open–close passes before the step is redone with 0.3·Δt (Shi: 6 + 2; walls of many blocks need 10–25 at an impact).",
+                        "Open–close passes before the step is redone with 0.3·Δt (Shi: 6 + 2; walls of many blocks need 10–25 at an impact). If at most 1 % of the contacts still change then, they are settled closed and locked instead.",
                     );
                     ui.add(slider(&mut e.contact.max_open_close_iterations, 1..=50));
                     ui.end_row();
