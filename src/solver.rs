@@ -245,12 +245,16 @@ impl Active {
     }
 
     fn tb(&self, blocks: &[Block]) -> Mat3x12 {
-        let j = &blocks[self.cand.key.j as usize];
         let xb = match self.rec.state {
             ContactState::Lock => self.rec.reference,
             _ => self.cand.xb,
         };
-        displacement_matrix(&(xb - j.mp.centroid))
+        self.tb_at(&xb, blocks)
+    }
+
+    /// T_b at the point `xb` of block j.
+    fn tb_at(&self, xb: &Vec3, blocks: &[Block]) -> Mat3x12 {
+        displacement_matrix(&(xb - blocks[self.cand.key.j as usize].mp.centroid))
     }
 }
 
@@ -826,8 +830,7 @@ impl Solver {
         let mut t = ContactStiffness::default();
         add_normal_stiffness(&mut t, &c.kin, key.penalty);
         if key.lock {
-            let j = &self.model.blocks[c.cand.key.j as usize];
-            let tb = displacement_matrix(&(key.reference - j.mp.centroid));
+            let tb = c.tb_at(&key.reference, &self.model.blocks);
             let p_tau = self.params.contact.shear_penalty(key.penalty);
             add_shear_spring_stiffness(&mut t, &c.ta, &tb, &c.cand.normal, p_tau);
         }
