@@ -8,7 +8,8 @@ use std::time::Instant;
 use crate::generate::column_wall;
 use crate::params::Method;
 use crate::scene::{self, Scene};
-use crate::solver::{RunTotals, Solver, SolverError};
+use crate::snapshot::RunTotals;
+use crate::solver::{Solver, SolverError};
 
 /// One timed run.
 #[derive(Clone, Debug)]

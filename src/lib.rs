@@ -5,17 +5,27 @@
 //! scheme ("DDA-3p") is kept as a baseline. Equation numbers (P1)…(P26) refer to that paper,
 //! plain numbers such as (5.4) to `shared/docs/dda3d-reference.md`.
 //!
-//! Data flows one way: [`scene`] → [`solver`] → [`snapshot`] → [`render`] / [`output`].
+//! Data flows one way:
+//!
+//! ```text
+//! scene ──▶ model ──▶ solver (activate → assemble → ALM / open–close → step control → commit)
+//!                        │  uses physics (geometry, mechanics, linear) and contact
+//!                        ▼
+//!                     snapshot ──▶ output (CSV, JSON)
+//!                              └─▶ render (wgpu) ──▶ ui (the viewer)
+//! ```
+//!
+//! [`params`] holds every tunable; [`cli`] is the binary's front end, [`generate`] and [`bench`]
+//! its scene generator and benchmark.
 
 pub mod bench;
 pub mod cli;
 pub mod contact;
 pub mod generate;
-pub mod geometry;
-pub mod linear;
-pub mod mechanics;
+pub mod model;
 pub mod output;
 pub mod params;
+pub mod physics;
 pub mod render;
 pub mod scene;
 pub mod snapshot;

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::snapshot::Snapshot;
-use crate::solver::{RunTotals, Timings};
+use crate::snapshot::{RunTotals, Timings};
 
 /// Streams one row per block and one per active contact for every completed step.
 pub struct RunWriter {

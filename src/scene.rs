@@ -23,14 +23,15 @@ use std::path::Path;
 use serde::Deserialize;
 use toml::Spanned;
 
-use crate::contact::{Shape, broad_phase};
-use crate::geometry::{
+use crate::contact::Shape;
+use crate::contact::detection::broad_phase;
+use crate::model::{Block, Model};
+use crate::params::{JointParams, SolverParams};
+use crate::physics::geometry::{
     Vec3, box_vertices, convex_hull, dodecahedron_vertices, overlap_depth, prism_vertices,
     rotation_xyz_degrees,
 };
-use crate::mechanics::Material;
-use crate::params::{JointParams, SolverParams};
-use crate::solver::{Block, Model};
+use crate::physics::mechanics::Material;
 
 /// A bad scene: one line naming the file, the line when known, and the problem.
 #[derive(Debug, Clone, PartialEq)]
@@ -323,7 +324,7 @@ fn check_overlaps(blocks: &[Block]) -> Result<(), (usize, String)> {
         .iter()
         .flat_map(|b| b.vertices.iter().copied())
         .collect();
-    let (lo, hi) = crate::geometry::bounding_box(&all);
+    let (lo, hi) = crate::physics::geometry::bounding_box(&all);
     let tol = 1e-4 * 0.5 * (hi - lo).max();
     let shapes: Vec<Shape> = blocks
         .iter()

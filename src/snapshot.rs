@@ -174,3 +174,38 @@ pub struct Snapshot {
     pub contacts: Vec<ContactSnapshot>,
     pub stats: StepStats,
 }
+
+/// Wall time spent in the phases of the solver.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct Timings {
+    pub detection: f64,
+    pub assembly: f64,
+    pub factorization: f64,
+    pub solve: f64,
+    pub bookkeeping: f64,
+}
+
+/// Totals over a run, for `summary.json` and the benchmark.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct RunTotals {
+    pub steps: u64,
+    pub open_close_iterations: u64,
+    pub alm_iterations: u64,
+    pub time_step_cuts: u64,
+    pub factorizations: u64,
+    pub symbolic_analyses: u64,
+    pub max_penetration: f64,
+    /// Largest kept overlap (see `StepStats::max_overlap`), m.
+    pub max_overlap: f64,
+    /// Steps whose open–close iteration did not converge within its pass limit and was settled
+    /// (the contacts still changing closed and locked for one more solve): at the Δt floor, or
+    /// with at most [`crate::params::step_rules::SETTLE_FRACTION`] of the contacts still changing.
+    pub unconverged_steps: u64,
+    /// ALM loops that hit the iteration cap.
+    pub alm_cap_hits: u64,
+    /// Contacts settled closed and locked: after cycling between states within one attempt, or
+    /// still changing at the open–close pass limit (see `unconverged_steps`).
+    pub frozen_contacts: u64,
+    pub contacts_per_step: f64,
+    pub timings: Timings,
+}

@@ -1,11 +1,12 @@
 //! Closed-form checks of the integrator and the kinematics (reference §9(d)).
 
-use dda3d::geometry::{
+use dda3d::model::{Block, Model};
+use dda3d::params::{Mode, SolverParams};
+use dda3d::physics::geometry::{
     Mat3, Vec3, box_vertices, convex_hull, mass_properties, rotation_xyz_degrees,
 };
-use dda3d::mechanics::Material;
-use dda3d::params::{Mode, SolverParams};
-use dda3d::solver::{Block, Model, Solver};
+use dda3d::physics::mechanics::Material;
+use dda3d::solver::Solver;
 
 const ROCK: Material = Material {
     density: 2750.0,

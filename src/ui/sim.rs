@@ -21,9 +21,11 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
+use crate::model::Model;
 use crate::params::SolverParams;
+use crate::snapshot::RunTotals;
 use crate::snapshot::{ContactState, Snapshot};
-use crate::solver::{Model, RunTotals, Solver};
+use crate::solver::Solver;
 
 /// How fast simulated time advances.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -400,6 +400,47 @@ pub fn prism_vertices(base: &[[f64; 3]], extrude: [f64; 3]) -> Vec<Vec3> {
         .collect()
 }
 
+/// Area of the convex hull of points that lie roughly in a plane with normal `n` (used to share
+/// a joint's area among its contact points for cohesion).
+pub fn planar_hull_area(points: &[Vec3], n: &Vec3) -> f64 {
+    if points.len() < 3 {
+        return 0.0;
+    }
+    let u = if n.x.abs() < 0.9 {
+        n.cross(&Vec3::x())
+    } else {
+        n.cross(&Vec3::y())
+    }
+    .normalize();
+    let v = n.cross(&u);
+    let mut p: Vec<(f64, f64)> = points.iter().map(|x| (x.dot(&u), x.dot(&v))).collect();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut hull: Vec<(f64, f64)> = Vec::new();
+    for &q in &p {
+        while hull.len() >= 2 && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
+            hull.pop();
+        }
+        hull.push(q);
+    }
+    let lower = hull.len() + 1;
+    for &q in p.iter().rev().skip(1) {
+        while hull.len() >= lower && cross(hull[hull.len() - 2], hull[hull.len() - 1], q) <= 0.0 {
+            hull.pop();
+        }
+        hull.push(q);
+    }
+    hull.pop();
+    let mut area = 0.0;
+    for k in 0..hull.len() {
+        let (a, b) = (hull[k], hull[(k + 1) % hull.len()]);
+        area += a.0 * b.1 - b.0 * a.1;
+    }
+    area.abs() / 2.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -547,5 +588,17 @@ mod tests {
         assert!(overlap_depth(&ve, &te, &vf, &tf) < 0.0);
         let (vg, tg) = hull(&box_vertices([2.0; 3], [0.0, 0.0, 2.0 * s - 0.01], &r2));
         assert!((overlap_depth(&ve, &te, &vg, &tg) - 0.01).abs() < 1e-9);
+    }
+
+    #[test]
+    fn hull_area() {
+        let pts = [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(2.0, 0.0, 1.0),
+            Vec3::new(2.0, 3.0, 1.0),
+            Vec3::new(0.0, 3.0, 1.0),
+            Vec3::new(1.0, 1.0, 1.0),
+        ];
+        assert!((planar_hull_area(&pts, &Vec3::z()) - 6.0).abs() < 1e-12);
     }
 }

@@ -15,7 +15,7 @@ use faer::sparse::linalg::{SupernodalThreshold, amd};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, MatMut, Par, Side};
 
-use crate::mechanics::Mat12;
+use crate::physics::mechanics::Mat12;
 
 /// Lower block triangle of K: diagonal blocks plus one 12×12 block K[hi][lo] per block pair.
 #[derive(Clone, Debug)]

@@ -5,7 +5,7 @@
 
 use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 
-use crate::geometry::{MassProperties, Mat3, Vec3};
+use crate::physics::geometry::{MassProperties, Mat3, Vec3};
 
 pub type Mat12 = SMatrix<f64, 12, 12>;
 pub type Vec12 = SVector<f64, 12>;
@@ -191,7 +191,7 @@ pub fn block_terms(b: &BlockStepInput, dt: f64) -> BlockTerms {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::{
+    use crate::physics::geometry::{
         Topology, box_vertices, convex_hull, mass_properties, rotation_xyz_degrees,
     };
 

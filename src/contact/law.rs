@@ -1,0 +1,331 @@
+//! The contact law as a pure state classification (reference §6.1): given what the last solve
+//! says of one contact, does it stay, close, open, start to slide, stick again, or slide on in a
+//! new direction? The solver applies the answer to the contact's record; nothing here touches
+//! the solver's state, so every rule is unit-tested on its own below.
+//!
+//! The rules:
+//! - an open contact closes when it penetrates beyond a small threshold (hysteresis against
+//!   open–close chatter: the role of Shi's s0);
+//! - a closed contact opens under tension beyond p_n,1·f0·w0 (Shi's gap test f0·w0, as a force,
+//!   with the initial penalty so that a stiffened contact cannot hold tension);
+//! - a locked contact slides when its shear spring force exceeds N tan φ + c·A (Mohr–Coulomb;
+//!   cohesion only while the joint is intact), and only when the spring's shear displacement
+//!   exceeds f0·w0 (hysteresis for contacts that carry no load);
+//! - a sliding contact sticks again when its slip reverses or stops, or when the friction held
+//!   during the ALM loop stayed below its capacity λ tan φ (see [`Observation::held_friction`]);
+//!   otherwise its friction follows the slip direction.
+
+use super::ContactState;
+use crate::physics::geometry::Vec3;
+
+/// The law's thresholds for one step.
+#[derive(Clone, Copy, Debug)]
+pub struct LawParams {
+    /// An open contact closes when it penetrates beyond this, m (`close_threshold · w0`).
+    pub close_penetration: f64,
+    /// A closed contact opens under a tension beyond this, N (p_n,1 · `open_threshold` · w0).
+    pub open_tension: f64,
+    /// Tangential displacements below this are neither slip nor a reversal of slip, m
+    /// (`open_threshold · w0`, Shi's f0·w0).
+    pub slip_tolerance: f64,
+    /// tan φ of the joint.
+    pub tan_phi: f64,
+    /// ε2 of (P24): a held friction counts as below the capacity λ tan φ only by more than
+    /// this fraction (the multipliers themselves are converged to ε2).
+    pub eps2: f64,
+}
+
+/// What the last solve says of one contact.
+#[derive(Clone, Copy, Debug)]
+pub struct Observation {
+    pub state: ContactState,
+    /// d_n, m, positive when penetrating.
+    pub penetration: f64,
+    /// N = λ + p_n d_n (ALM) or p_n d_n (penalty), N, positive in compression.
+    pub normal_force: f64,
+    /// Locked: the shear spring's extension N(Δ + Δu_ab), m, tangential. Ignored otherwise.
+    pub shear: Vec3,
+    /// p_τ of a locked contact, N/m.
+    pub shear_stiffness: f64,
+    /// Cohesive strength c·A of an intact joint, N (0 once it has opened or slid).
+    pub cohesion: f64,
+    /// The tangential part of the relative displacement Δu_ab, m.
+    pub slip: Vec3,
+    /// Sliding direction of a sliding contact.
+    pub tau: Vec3,
+    /// λ, N.
+    pub lambda: f64,
+    /// The multiplier at which a sliding contact's friction was held during the ALM loop,
+    /// because its slip reversed there (see the solver's ALM loop); `None` if it was not.
+    pub held_friction: Option<f64>,
+}
+
+/// The law's verdict on one contact.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Transition {
+    /// Stays as it is.
+    Keep,
+    /// An open contact closes, locked with a fresh shear spring.
+    Close,
+    /// A closed contact opens (and loses its cohesion).
+    Open,
+    /// A locked contact starts to slide along `tau` (and loses its cohesion).
+    Slide { tau: Vec3 },
+    /// A sliding contact sticks: locked with a fresh shear spring.
+    Stick,
+    /// A sliding contact slides on along the new direction `tau`.
+    Turn { tau: Vec3 },
+}
+
+/// Classifies one contact from the last solve.
+pub fn classify(o: &Observation, p: &LawParams) -> Transition {
+    match o.state {
+        ContactState::Open => {
+            if o.penetration > p.close_penetration {
+                Transition::Close
+            } else {
+                Transition::Keep
+            }
+        }
+        _ if o.normal_force < -p.open_tension => Transition::Open,
+        ContactState::Lock => {
+            let extension = o.shear.norm();
+            let strength = o.normal_force * p.tan_phi + o.cohesion;
+            if extension > p.slip_tolerance && o.shear_stiffness * extension > strength {
+                Transition::Slide {
+                    tau: o.shear.normalize(),
+                }
+            } else {
+                Transition::Keep
+            }
+        }
+        ContactState::Slide => {
+            // The slip reversed, or stopped: the contact sticks again. So does a contact whose
+            // friction was held below its capacity λ tan φ: the slip reversed under a smaller
+            // friction and goes forward under the held one, so a friction within the capacity
+            // stops it.
+            let held_below = o
+                .held_friction
+                .is_some_and(|held| held < (1.0 - p.eps2) * o.lambda);
+            if reversed(&o.slip, &o.tau, p.slip_tolerance)
+                || o.slip.norm() < p.slip_tolerance
+                || held_below
+            {
+                Transition::Stick
+            } else if o.slip.norm() > p.slip_tolerance {
+                // Friction follows the slip direction; it has not reversed here, so friction
+                // along the old direction still did negative work.
+                Transition::Turn {
+                    tau: o.slip.normalize(),
+                }
+            } else {
+                Transition::Keep
+            }
+        }
+    }
+}
+
+/// True when `motion` goes back against the sliding direction `tau` by more than `tolerance`.
+pub fn reversed(motion: &Vec3, tau: &Vec3, tolerance: f64) -> bool {
+    motion.dot(tau) < -tolerance
+}
+
+/// The settled state of a contact whose open–close state does not converge: closed and locked
+/// where the last solve left it touching or penetrating, open where it left a gap beyond the
+/// closing threshold. A contact closed across a gap is a spring stretched by that gap: with an
+/// adapted penalty of up to γE it pulled a 12 mm gap shut within one step and gave a 40-block
+/// wall 0.1 MJ. Locked rather than sliding because a spring stores energy and gives it back,
+/// whereas sliding friction along a guessed direction can push the slip it should resist
+/// (settling as sliding fed a 100-block wall energy).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Settled {
+    Open,
+    /// Locked; `fresh_spring` when it was not locked before (its spring starts here).
+    Lock {
+        fresh_spring: bool,
+    },
+}
+
+/// See [`Settled`].
+pub fn settle(state: ContactState, penetration: f64, close_penetration: f64) -> Settled {
+    if penetration < -close_penetration {
+        Settled::Open
+    } else {
+        Settled::Lock {
+            fresh_spring: state != ContactState::Lock,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn law() -> LawParams {
+        LawParams {
+            close_penetration: 1e-6,
+            open_tension: 100.0,
+            slip_tolerance: 1e-6,
+            tan_phi: 35f64.to_radians().tan(),
+            eps2: 0.01,
+        }
+    }
+
+    fn seen(state: ContactState) -> Observation {
+        Observation {
+            state,
+            penetration: 0.0,
+            normal_force: 1e4,
+            shear: Vec3::zeros(),
+            shear_stiffness: 1e8,
+            cohesion: 0.0,
+            slip: Vec3::zeros(),
+            tau: Vec3::x(),
+            lambda: 1e4,
+            held_friction: None,
+        }
+    }
+
+    #[test]
+    fn an_open_contact_closes_only_beyond_the_threshold() {
+        let p = law();
+        let mut o = seen(ContactState::Open);
+        for (dn, want) in [
+            (-1e-3, Transition::Keep),
+            (0.0, Transition::Keep),
+            (0.5e-6, Transition::Keep),
+            (2e-6, Transition::Close),
+        ] {
+            o.penetration = dn;
+            assert_eq!(classify(&o, &p), want, "d_n = {dn}");
+        }
+    }
+
+    #[test]
+    fn a_closed_contact_opens_only_under_tension_beyond_the_threshold() {
+        let p = law();
+        for state in [ContactState::Lock, ContactState::Slide] {
+            let mut o = seen(state);
+            o.slip = Vec3::new(1e-3, 0.0, 0.0);
+            o.normal_force = -50.0;
+            assert_ne!(
+                classify(&o, &p),
+                Transition::Open,
+                "{state:?}: slight tension"
+            );
+            o.normal_force = -150.0;
+            assert_eq!(classify(&o, &p), Transition::Open, "{state:?}");
+        }
+    }
+
+    /// Mohr–Coulomb over a family of normal forces and friction angles: the contact slides
+    /// exactly when p_τ·|shear| > N tan φ.
+    #[test]
+    fn a_locked_contact_slides_beyond_its_friction_strength() {
+        for phi in [10.0f64, 30.0, 45.0] {
+            let p = LawParams {
+                tan_phi: phi.to_radians().tan(),
+                ..law()
+            };
+            for n in [1e2, 1e4, 1e6] {
+                let limit = n * p.tan_phi / 1e8; // extension at the strength, m
+                let mut o = seen(ContactState::Lock);
+                o.normal_force = n;
+                o.shear = Vec3::new(0.0, -0.99 * limit.max(2e-6), 0.0);
+                if 0.99 * limit > p.slip_tolerance {
+                    assert_eq!(classify(&o, &p), Transition::Keep, "φ {phi}, N {n}");
+                }
+                o.shear = Vec3::new(0.0, -1.01 * limit.max(2e-6), 0.0);
+                assert_eq!(
+                    classify(&o, &p),
+                    Transition::Slide { tau: -Vec3::y() },
+                    "φ {phi}, N {n}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn cohesion_adds_to_the_strength_of_an_intact_joint() {
+        let p = law();
+        let mut o = seen(ContactState::Lock);
+        let friction = o.normal_force * p.tan_phi;
+        o.shear = Vec3::x() * (1.1 * friction / o.shear_stiffness);
+        assert!(matches!(classify(&o, &p), Transition::Slide { .. }));
+        o.cohesion = 0.2 * friction;
+        assert_eq!(
+            classify(&o, &p),
+            Transition::Keep,
+            "10 % reserve from cohesion"
+        );
+    }
+
+    /// Hysteresis: a contact carrying no normal force does not flip to sliding for a shear
+    /// displacement below f0·w0.
+    #[test]
+    fn tiny_shear_of_an_unloaded_contact_is_not_slip() {
+        let p = law();
+        let mut o = seen(ContactState::Lock);
+        o.normal_force = 0.0;
+        o.shear = Vec3::x() * 0.5e-6;
+        assert_eq!(classify(&o, &p), Transition::Keep);
+        o.shear = Vec3::x() * 2e-6;
+        assert!(matches!(classify(&o, &p), Transition::Slide { .. }));
+    }
+
+    #[test]
+    fn a_sliding_contact_sticks_when_its_slip_reverses_or_stops() {
+        let p = law();
+        let mut o = seen(ContactState::Slide);
+        o.slip = Vec3::new(-2e-6, 0.0, 0.0);
+        assert_eq!(classify(&o, &p), Transition::Stick, "reversed");
+        o.slip = Vec3::new(0.0, 0.5e-6, 0.0);
+        assert_eq!(classify(&o, &p), Transition::Stick, "stopped");
+        o.slip = Vec3::new(1e-3, 1e-3, 0.0);
+        match classify(&o, &p) {
+            Transition::Turn { tau } => {
+                let want = Vec3::new(1.0, 1.0, 0.0).normalize();
+                assert!(
+                    (tau - want).norm() < 1e-15,
+                    "friction follows the slip: {tau}"
+                );
+            }
+            t => panic!("{t:?}"),
+        }
+    }
+
+    #[test]
+    fn a_sliding_contact_whose_friction_was_held_below_capacity_sticks() {
+        let p = law();
+        let mut o = seen(ContactState::Slide);
+        o.slip = Vec3::new(1e-3, 0.0, 0.0);
+        o.held_friction = Some(0.995 * o.lambda);
+        assert!(
+            matches!(classify(&o, &p), Transition::Turn { .. }),
+            "within ε2"
+        );
+        o.held_friction = Some(0.9 * o.lambda);
+        assert_eq!(classify(&o, &p), Transition::Stick);
+    }
+
+    #[test]
+    fn settling_closes_and_locks_unless_a_gap_is_left() {
+        let c = 1e-6;
+        assert_eq!(settle(ContactState::Slide, -2e-6, c), Settled::Open);
+        assert_eq!(settle(ContactState::Lock, -2e-6, c), Settled::Open);
+        assert_eq!(
+            settle(ContactState::Slide, -0.5e-6, c),
+            Settled::Lock { fresh_spring: true }
+        );
+        assert_eq!(
+            settle(ContactState::Open, 1e-4, c),
+            Settled::Lock { fresh_spring: true }
+        );
+        assert_eq!(
+            settle(ContactState::Lock, 1e-4, c),
+            Settled::Lock {
+                fresh_spring: false
+            }
+        );
+    }
+}

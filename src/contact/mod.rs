@@ -1,0 +1,130 @@
+//! Contacts between convex polyhedral blocks.
+//!
+//! - [`detection`]: which features of which block pairs may touch in this step;
+//! - [`kinematics`]: the linearised normal distance and the contact submatrices;
+//! - [`law`]: the contact law as a pure state classification (open / lock / slide, hysteresis,
+//!   friction reversal, cohesion);
+//! - [`record`]: what a contact carries from one step to the next.
+//!
+//! The types below name a contact ([`ContactKey`]), what detection sees of a block ([`Shape`])
+//! and what it finds ([`Candidate`]).
+
+pub mod detection;
+pub mod kinematics;
+pub mod law;
+pub mod record;
+
+use crate::model::Block;
+use crate::physics::geometry::{Topology, Vec3};
+pub use crate::snapshot::{ContactMode, ContactState};
+
+/// Identity of a contact across steps: the blocks and the features that touch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ContactKey {
+    /// Block owning the vertex (V–F) or the first edge (E–E).
+    pub i: u32,
+    /// Block owning the face (V–F) or the second edge (E–E).
+    pub j: u32,
+    pub mode: u8,
+    /// Vertex index in i (V–F) or edge index in i (E–E).
+    pub feature_i: u32,
+    /// Face index in j (V–F) or edge index in j (E–E).
+    pub feature_j: u32,
+}
+
+impl ContactKey {
+    pub fn mode(&self) -> ContactMode {
+        if self.mode == 0 {
+            ContactMode::VertexFace
+        } else {
+            ContactMode::EdgeEdge
+        }
+    }
+}
+
+/// A block as contact detection sees it at the start of a step.
+#[derive(Clone, Debug)]
+pub struct Shape<'a> {
+    pub vertices: &'a [Vec3],
+    pub topo: &'a Topology,
+    /// Unit outward face normals.
+    pub face_normals: &'a [Vec3],
+    pub centroid: Vec3,
+    pub lo: Vec3,
+    pub hi: Vec3,
+    pub fixed: bool,
+}
+
+/// Tolerances of the narrow phase (reference §4, §10).
+#[derive(Clone, Copy, Debug)]
+pub struct DetectionParams {
+    /// d_s: contacts are sought up to this gap.
+    pub search_distance: f64,
+    /// d_pen: deepest penetration still treated as a contact.
+    pub max_penetration: f64,
+    /// ε_in: slack of the point-in-face test, m.
+    pub inside_tolerance: f64,
+    /// sin θ_a of the entrance-angle tests (θ_a ≈ 3°).
+    pub sin_entrance: f64,
+    /// sin θ_p below which two edges count as parallel (θ_p ≈ 3°).
+    pub sin_parallel: f64,
+    /// ε_e: margin of the edge parameters of an edge-edge contact.
+    pub edge_margin: f64,
+    /// Contacts of one block pair closer than this are one physical constraint.
+    pub merge_distance: f64,
+}
+
+impl DetectionParams {
+    /// Shi's control lengths for a model of half-extent `w0` and displacement ratio δ.
+    pub fn new(w0: f64, delta: f64) -> Self {
+        let ds = 2.5 * delta * w0;
+        let sin3 = 3f64.to_radians().sin();
+        DetectionParams {
+            search_distance: ds,
+            max_penetration: 0.3 * ds,
+            inside_tolerance: 1e-6 * w0,
+            sin_entrance: sin3,
+            sin_parallel: sin3,
+            edge_margin: 1e-3,
+            merge_distance: 1e-3 * ds,
+        }
+    }
+}
+
+/// A contact found at the start of a step, with its frozen geometry.
+#[derive(Clone, Debug)]
+pub struct Candidate {
+    pub key: ContactKey,
+    /// P1…P4 of (5.1): V–F: the vertex, then three corners of the face; E–E: the edge of i,
+    /// then the edge of j.
+    pub points: [Vec3; 4],
+    /// Unit normal out of block j toward block i.
+    pub normal: Vec3,
+    /// Signed gap, m (negative when penetrating).
+    pub gap: f64,
+    /// Contact point on block i (the vertex, or the closest point of edge i).
+    pub xa: Vec3,
+    /// Closest point of block j to `xa`.
+    pub xb: Vec3,
+}
+
+impl Candidate {
+    pub fn mode(&self) -> ContactMode {
+        self.key.mode()
+    }
+}
+
+impl<'a> Shape<'a> {
+    /// What detection sees of `block` now.
+    pub fn of(block: &'a Block) -> Self {
+        Shape {
+            vertices: &block.vertices,
+            topo: &block.topo,
+            face_normals: &block.face_normals,
+            centroid: block.mp.centroid,
+            lo: block.lo,
+            hi: block.hi,
+            fixed: block.fixed,
+        }
+    }
+}

@@ -1,0 +1,124 @@
+//! The model: the blocks a scene builds and the solver steps. A [`Block`] holds its geometry,
+//! material, the 12-DOF velocity carried between steps, and its accumulated stress and strain;
+//! everything derived from the vertex positions is refreshed by [`Block::refresh`] after each
+//! step's finite-rotation update.
+
+use std::sync::Arc;
+
+use nalgebra::{Matrix6, Vector6};
+
+use crate::physics::geometry::{
+    MassProperties, Topology, Vec3, bounding_box, mass_properties, newell_normal,
+};
+use crate::physics::mechanics::{Mat12, Material, Vec12, elasticity_matrix, mass_matrix};
+
+/// One deformable block and its state carried between steps.
+#[derive(Clone, Debug)]
+pub struct Block {
+    pub name: String,
+    pub material: Material,
+    /// Held at every vertex by springs of `fixed_spring_factor · E`.
+    pub fixed: bool,
+    pub vertices: Vec<Vec3>,
+    pub topo: Arc<Topology>,
+    /// Unit outward normals, refreshed with the vertices.
+    pub face_normals: Vec<Vec3>,
+    pub mp: MassProperties,
+    /// Constant mass; the density follows the volume so that mass is conserved (§1.3).
+    pub mass: f64,
+    pub density: f64,
+    pub mass_matrix: Mat12,
+    pub elasticity: Matrix6<f64>,
+    /// 12-vector of DOF rates carried between steps (§3.2).
+    pub velocity: Vec12,
+    /// Accumulated stress [σx, σy, σz, τyz, τzx, τxy], Pa.
+    pub stress: Vector6<f64>,
+    pub strain: Vector6<f64>,
+    /// Spring anchors of a fixed block: the initial vertex positions.
+    pub anchors: Vec<Vec3>,
+    /// Point loads: (material point, force N).
+    pub loads: Vec<(Vec3, Vec3)>,
+    pub initial_centroid: Vec3,
+    pub lo: Vec3,
+    pub hi: Vec3,
+}
+
+impl Block {
+    /// A block from its hull; `velocity` is the initial centroid velocity and `spin` the initial
+    /// angular velocity (rad/s).
+    #[allow(clippy::too_many_arguments)]
+    pub fn new(
+        name: String,
+        material: Material,
+        fixed: bool,
+        vertices: Vec<Vec3>,
+        topo: Topology,
+        velocity: Vec3,
+        spin: Vec3,
+        loads: Vec<(Vec3, Vec3)>,
+    ) -> Self {
+        let mp = mass_properties(&vertices, &topo.faces);
+        let mut v = Vec12::zeros();
+        v.fixed_rows_mut::<3>(0).copy_from(&velocity);
+        v.fixed_rows_mut::<3>(3).copy_from(&spin);
+        let mut b = Block {
+            name,
+            material,
+            fixed,
+            anchors: if fixed { vertices.clone() } else { Vec::new() },
+            vertices,
+            topo: Arc::new(topo),
+            face_normals: Vec::new(),
+            mp,
+            mass: material.density * mp.volume,
+            density: material.density,
+            mass_matrix: Mat12::zeros(),
+            elasticity: elasticity_matrix(material.young_modulus, material.poisson_ratio),
+            velocity: v,
+            stress: Vector6::zeros(),
+            strain: Vector6::zeros(),
+            loads,
+            initial_centroid: mp.centroid,
+            lo: Vec3::zeros(),
+            hi: Vec3::zeros(),
+        };
+        b.refresh();
+        b
+    }
+
+    /// Recomputes everything derived from the vertex positions.
+    pub fn refresh(&mut self) {
+        self.face_normals = self
+            .topo
+            .faces
+            .iter()
+            .map(|f| newell_normal(&self.vertices, f).normalize())
+            .collect();
+        self.mp = mass_properties(&self.vertices, &self.topo.faces);
+        self.density = self.mass / self.mp.volume;
+        self.mass_matrix = mass_matrix(self.density, &self.mp);
+        let (lo, hi) = bounding_box(&self.vertices);
+        self.lo = lo;
+        self.hi = hi;
+    }
+
+    /// ½ vᵀ M v.
+    pub fn kinetic_energy(&self) -> f64 {
+        0.5 * (self.velocity.transpose() * self.mass_matrix * self.velocity)[0]
+    }
+
+    /// Largest distance from the centroid to a vertex.
+    pub fn radius(&self) -> f64 {
+        self.vertices
+            .iter()
+            .map(|v| (v - self.mp.centroid).norm())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// The blocks of a scene.
+#[derive(Clone, Debug)]
+pub struct Model {
+    pub name: String,
+    pub blocks: Vec<Block>,
+}

@@ -1,0 +1,201 @@
+//! The first stage of a step: detect the contacts and attach each to the record it carried from
+//! the last step, or to a new one (reference §4.5), with its normal kinematics frozen for the
+//! step.
+
+use std::collections::HashMap;
+
+use super::active::Active;
+use super::counters::debug_log;
+use crate::contact::detection::{broad_phase, detect_pair};
+use crate::contact::kinematics::normal_kinematics;
+use crate::contact::record::ContactRecord;
+use crate::contact::{Candidate, ContactKey, ContactState, DetectionParams, Shape};
+use crate::model::Block;
+use crate::params::{Method, SolverParams};
+use crate::physics::geometry::{Vec3, planar_hull_area};
+use crate::physics::mechanics::displacement_matrix;
+
+/// Fraction of a kept overlap released each step (see [`keep_overlap`]).
+const OVERLAP_RELEASE: f64 = 0.1;
+
+/// What activation reads.
+pub(crate) struct ActivationInputs<'a> {
+    pub params: &'a SolverParams,
+    pub blocks: &'a [Block],
+    pub records: &'a HashMap<ContactKey, ContactRecord>,
+    /// Shi's w0, m.
+    pub w0: f64,
+    /// The step about to be taken (0 for the first) and its start time.
+    pub step: u64,
+    pub time: f64,
+}
+
+/// This step's contacts, and the block pairs near each other (the broad phase's pairs, sorted).
+pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, Vec<(usize, usize)>) {
+    let p = inp.params;
+    let dp = DetectionParams::new(inp.w0, p.max_displacement_ratio);
+    let shapes: Vec<Shape> = inp.blocks.iter().map(Shape::of).collect();
+    let near = broad_phase(&shapes, dp.search_distance);
+    let known = |k: &ContactKey| inp.records.contains_key(k);
+    let mut cands: Vec<Candidate> = Vec::new();
+    for &(a, b) in &near {
+        cands.extend(detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known));
+    }
+    // Contact transfer: a vertex that slid onto an adjacent, almost coplanar face of the same
+    // block keeps its history.
+    let mut by_vertex: HashMap<(u32, u32, u32), ContactKey> = HashMap::new();
+    for k in inp.records.keys() {
+        if k.mode == 0 {
+            by_vertex.insert((k.i, k.j, k.feature_i), *k);
+        }
+    }
+    let mut active: Vec<Active> = cands
+        .into_iter()
+        .map(|cand| activate_one(inp, &by_vertex, cand))
+        .collect();
+    if inp.step == 0 && p.joint.cohesion > 0.0 {
+        assign_cohesion_areas(&mut active);
+    }
+    (active, near)
+}
+
+/// One detected contact with its record and frozen kinematics.
+fn activate_one(
+    inp: &ActivationInputs,
+    by_vertex: &HashMap<(u32, u32, u32), ContactKey>,
+    cand: Candidate,
+) -> Active {
+    let p = inp.params;
+    let blocks = inp.blocks;
+    let (bi, bj) = (&blocks[cand.key.i as usize], &blocks[cand.key.j as usize]);
+    let mut kin = normal_kinematics(
+        cand.mode(),
+        &cand.points,
+        &cand.normal,
+        &bi.mp.centroid,
+        &bj.mp.centroid,
+    );
+    let old = inp.records.get(&cand.key).copied().or_else(|| {
+        if cand.key.mode != 0 {
+            return None;
+        }
+        let k = by_vertex.get(&(cand.key.i, cand.key.j, cand.key.feature_i))?;
+        let r = inp.records.get(k)?;
+        (r.normal.dot(&cand.normal) > 3f64.to_radians().cos()).then_some(*r)
+    });
+    let mut rec = match old {
+        Some(mut r) => {
+            // Warm start: λ and the adapted p_n carry over. Resetting p_n to p_n,1 every step
+            // was tried: with ε2 = 0.01 the multiplier then lags by up to 1 % a step, and a
+            // standing column slowly rocks itself apart.
+            if !p.contact.warm_start || p.method == Method::Penalty {
+                r.lambda = 0.0;
+                r.penalty = p.contact.initial_penalty;
+            }
+            r.normal = cand.normal;
+            r
+        }
+        None => new_record(inp, &cand),
+    };
+    if p.method == Method::Penalty {
+        rec.penalty = p.contact.initial_penalty;
+    }
+    let unseen = old.is_none_or(|r| r.state == ContactState::Open);
+    keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen);
+    let ta = displacement_matrix(&(cand.xa - bi.mp.centroid));
+    Active {
+        kin,
+        ta,
+        young: bi.material.young_modulus.min(bj.material.young_modulus),
+        start: rec,
+        rec,
+        cand,
+        pair: 0,
+        dn: 0.0,
+        force: 0.0,
+        dn_prev: None,
+        friction_cap: None,
+        flips: 0,
+        frozen: false,
+        changed: false,
+        shear: Vec3::zeros(),
+        slip: Vec3::zeros(),
+    }
+}
+
+/// The record of a contact seen for the first time: closed (locked) if it is touching or
+/// overlapping, open across a gap. Only contacts closed at t = 0 are intact (have cohesion).
+fn new_record(inp: &ActivationInputs, cand: &Candidate) -> ContactRecord {
+    let p = inp.params;
+    let close_tol = p.contact.close_threshold * inp.w0;
+    let touching = -cand.gap > -close_tol;
+    ContactRecord {
+        state: if touching {
+            ContactState::Lock
+        } else {
+            ContactState::Open
+        },
+        lambda: 0.0,
+        penalty: p.contact.initial_penalty,
+        normal_force: 0.0,
+        shear_force: 0.0,
+        penetration: -cand.gap,
+        reference: cand.xb,
+        tau: Vec3::zeros(),
+        normal: cand.normal,
+        intact: inp.step == 0 && touching,
+        cohesion_area: 0.0,
+        overlap: 0.0,
+    }
+}
+
+/// A contact seen for the first time already deeper than the ALM tolerance (a corner that
+/// slipped past detection, or an open contact whose linearised gap was wrong) keeps that overlap
+/// instead of having it pushed out in one step: resolved within one step, an overlap of
+/// millimetres takes meganewtons and comes back as kinetic energy the system never had. The
+/// overlap is taken out of d0; it shrinks as the blocks separate and by [`OVERLAP_RELEASE`] of
+/// itself a step.
+fn keep_overlap(
+    inp: &ActivationInputs,
+    cand: &Candidate,
+    rec: &mut ContactRecord,
+    d0: &mut f64,
+    unseen: bool,
+) {
+    let p = inp.params;
+    let overlap_tol = p.contact.eps1 * (2.0 * p.max_displacement_ratio * inp.w0);
+    rec.overlap = (rec.overlap * (1.0 - OVERLAP_RELEASE)).min(d0.max(0.0));
+    if unseen && *d0 > overlap_tol {
+        rec.overlap = *d0;
+        if debug_log() {
+            eprintln!(
+                "t={:.4}: contact {:?} first seen {:.3e} m deep; the overlap is kept",
+                inp.time, cand.key, d0
+            );
+        }
+    }
+    *d0 -= rec.overlap;
+}
+
+/// Shares each joint's contact area among its contact points (for cohesion, which acts only on
+/// intact contacts of the initial state).
+fn assign_cohesion_areas(active: &mut [Active]) {
+    let mut groups: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (k, c) in active.iter().enumerate() {
+        if c.rec.intact {
+            let key = (
+                c.cand.key.i.min(c.cand.key.j),
+                c.cand.key.i.max(c.cand.key.j),
+            );
+            groups.entry(key).or_default().push(k);
+        }
+    }
+    for idx in groups.values() {
+        let pts: Vec<Vec3> = idx.iter().map(|&k| active[k].cand.xb).collect();
+        let area = planar_hull_area(&pts, &active[idx[0]].cand.normal);
+        for &k in idx {
+            active[k].rec.cohesion_area = area / idx.len() as f64;
+            active[k].start.cohesion_area = area / idx.len() as f64;
+        }
+    }
+}

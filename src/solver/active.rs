@@ -1,0 +1,117 @@
+//! A contact inside a step: its geometry frozen at the start of the step, the record it carries,
+//! and the working values of the iterations (d_n, N, the flips of the open–close check).
+
+use crate::contact::kinematics::NormalKinematics;
+use crate::contact::law::{self, Settled};
+use crate::contact::record::ContactRecord;
+use crate::contact::{Candidate, ContactState};
+use crate::model::Block;
+use crate::physics::geometry::Vec3;
+use crate::physics::mechanics::{Mat3x12, Vec12, displacement_matrix};
+
+/// A contact inside a step.
+pub(crate) struct Active {
+    pub cand: Candidate,
+    pub kin: NormalKinematics,
+    pub rec: ContactRecord,
+    /// Record at the start of the step, restored when an attempt is redone.
+    pub start: ContactRecord,
+    /// T_a at the contact point of block i.
+    pub ta: Mat3x12,
+    /// Index of the block pair in the global matrix's pattern.
+    pub pair: usize,
+    /// The smaller Young's modulus of the two blocks: the cap γE of (P21b).
+    pub young: f64,
+    /// d_n after the last solve (5.4), m.
+    pub dn: f64,
+    /// N after the last solve (5.6), N.
+    pub force: f64,
+    /// d_n of the previous ALM iteration, for (P21).
+    pub dn_prev: Option<f64>,
+    /// Friction magnitude of a sliding contact whose slip reversed in this pass, held (see the
+    /// ALM loop).
+    pub friction_cap: Option<f64>,
+    /// State changes of this contact in the current attempt (to stop open–close cycles).
+    pub flips: u8,
+    /// Settled after cycling: no more state changes in this attempt.
+    pub frozen: bool,
+    /// Changed state in the last open–close pass.
+    pub changed: bool,
+    /// N(Δ + Δu_ab) of a locked contact after the last solve.
+    pub shear: Vec3,
+    /// Δu_ab projected on the tangent plane after the last solve.
+    pub slip: Vec3,
+}
+
+/// What a contact's stiffness depends on within an attempt (its kinematics are frozen): nothing
+/// if open; p_n if sliding; p_n and the reference point of the shear spring if locked.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct StiffnessKey {
+    pub lock: bool,
+    pub penalty: f64,
+    pub reference: Vec3,
+}
+
+impl Active {
+    /// The block indices (i, j).
+    pub fn blocks(&self) -> (usize, usize) {
+        (self.cand.key.i as usize, self.cand.key.j as usize)
+    }
+
+    /// Applies the settled state of [`law::settle`] to a contact whose open–close state does
+    /// not converge.
+    pub fn settle(&mut self, close_tol: f64) {
+        match law::settle(self.rec.state, self.dn, close_tol) {
+            Settled::Open => {
+                self.rec.state = ContactState::Open;
+                self.rec.lambda = 0.0;
+            }
+            Settled::Lock { fresh_spring: true } => {
+                self.rec.state = ContactState::Lock;
+                self.rec.reference = self.cand.xb;
+            }
+            Settled::Lock {
+                fresh_spring: false,
+            } => {}
+        }
+    }
+
+    /// See [`StiffnessKey`].
+    pub fn stiffness_key(&self) -> Option<StiffnessKey> {
+        match self.rec.state {
+            ContactState::Open => None,
+            ContactState::Slide => Some(StiffnessKey {
+                lock: false,
+                penalty: self.rec.penalty,
+                reference: Vec3::zeros(),
+            }),
+            ContactState::Lock => Some(StiffnessKey {
+                lock: true,
+                penalty: self.rec.penalty,
+                reference: self.rec.reference,
+            }),
+        }
+    }
+
+    /// Δu_ab = T_a D_i − T_b D_j (reference §6.1) for the solution `d`.
+    pub fn relative_displacement(&self, d: &[f64], blocks: &[Block]) -> Vec3 {
+        let (i, j) = self.blocks();
+        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+        let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
+        self.ta * di - self.tb(blocks) * dj
+    }
+
+    /// T_b at the contact's point of block j: the spring's reference point if locked.
+    pub fn tb(&self, blocks: &[Block]) -> Mat3x12 {
+        let xb = match self.rec.state {
+            ContactState::Lock => self.rec.reference,
+            _ => self.cand.xb,
+        };
+        self.tb_at(&xb, blocks)
+    }
+
+    /// T_b at the point `xb` of block j.
+    pub fn tb_at(&self, xb: &Vec3, blocks: &[Block]) -> Mat3x12 {
+        displacement_matrix(&(xb - blocks[self.cand.key.j as usize].mp.centroid))
+    }
+}

@@ -1,0 +1,228 @@
+//! The augmented Lagrangian loop of one open–close pass (paper Fig. 3): with the contact states
+//! fixed, solve, update every multiplier (P1), raise the penalty of slowly converging contacts
+//! (P21), until both convergence tests (P23) and (P24) hold. In penalty mode (DDA-3p) the loop
+//! is a single solve.
+
+use super::active::Active;
+use super::assemble::{StiffnessSync, load_vector};
+use super::counters::{Counters, Stopwatch};
+use super::step_control::Retry;
+use crate::contact::{ContactState, law};
+use crate::model::Block;
+use crate::params::{ContactParams, Method, SolverParams};
+use crate::physics::linear::{BlockMatrix, SparseCholesky};
+use crate::physics::mechanics::{Mat12, Vec12};
+
+/// Iterations of an ALM loop (after the first) at which (P21) may raise penalties. Each raise
+/// means a new factorization; later iterations only update λ and reuse it (back-substitutions).
+const PENALTY_ROUNDS: u32 = 2;
+
+/// Penetrations below this fraction of the ALM tolerance ε1·d_n,max do not raise the penalty.
+const PENALTY_FLOOR: f64 = 0.01;
+
+/// What an ALM loop reads and does not change.
+pub(crate) struct AlmInputs<'a> {
+    pub params: &'a SolverParams,
+    pub blocks: &'a [Block],
+    /// K0 and F0 of the attempt.
+    pub k0: &'a [Mat12],
+    pub f0: &'a [Vec12],
+    /// d_n,max = 2 δ w0 of (P22), m.
+    pub dn_max: f64,
+    /// f0·w0: slip below this is not a reversal, m.
+    pub slip_tolerance: f64,
+    /// The last pass of a non-converging open–close iteration: no more friction holds.
+    pub settling: bool,
+}
+
+/// The global system of an attempt: K kept in step with the contacts, and its factorization.
+pub(crate) struct System<'a> {
+    pub kmat: &'a mut BlockMatrix,
+    pub sync: &'a mut StiffnessSync,
+    pub chol: &'a mut SparseCholesky,
+}
+
+/// The result of one ALM loop.
+pub(crate) struct AlmOutcome {
+    /// The displacement increments D of the last solve.
+    pub d: Vec<f64>,
+    pub solves: u32,
+    /// Both tests held before the iteration cap.
+    pub converged: bool,
+}
+
+/// Runs the ALM loop of one open–close pass.
+pub(crate) fn alm_loop(
+    inp: &AlmInputs,
+    sys: &mut System,
+    active: &mut [Active],
+    counters: &mut Counters,
+) -> Result<AlmOutcome, Retry> {
+    let p = inp.params;
+    let cp = &p.contact;
+    let mut k_dirty = true;
+    for c in active.iter_mut() {
+        c.dn_prev = None;
+        c.friction_cap = None;
+    }
+    for alm_k in 1..=cp.max_alm_iterations {
+        // One linear solve an iteration.
+        let solves = alm_k;
+        let d = solve(inp, sys, active, counters, k_dirty)?;
+        let watch = Stopwatch::start();
+        let (conv1, conv2) = measure(p, inp.dn_max, &d, active);
+        if p.method == Method::Penalty {
+            counters.assembly += watch.elapsed();
+            return Ok(AlmOutcome {
+                d,
+                solves,
+                converged: true,
+            });
+        }
+        // K changes only where (P21) raised a penalty.
+        k_dirty = update_multipliers(cp, inp.dn_max, alm_k, conv1 && conv2, active);
+        if !inp.settling {
+            hold_reversed_friction(inp, &d, active);
+        }
+        counters.assembly += watch.elapsed();
+        if conv1 && conv2 {
+            return Ok(AlmOutcome {
+                d,
+                solves,
+                converged: true,
+            });
+        }
+        if alm_k == cp.max_alm_iterations {
+            return Ok(AlmOutcome {
+                d,
+                solves,
+                converged: false,
+            });
+        }
+    }
+    unreachable!("max_alm_iterations is at least 1 (validated)")
+}
+
+/// One linear solve: K brought up to date and refactorized if it changed, F assembled, D = K⁻¹F.
+fn solve(
+    inp: &AlmInputs,
+    sys: &mut System,
+    active: &[Active],
+    counters: &mut Counters,
+    k_dirty: bool,
+) -> Result<Vec<f64>, Retry> {
+    let watch = Stopwatch::start();
+    if k_dirty {
+        sys.sync
+            .update(sys.kmat, inp.k0, &inp.params.contact, inp.blocks, active);
+    }
+    let mut f = load_vector(inp.params, inp.blocks, inp.f0, active);
+    counters.assembly += watch.elapsed();
+    if k_dirty {
+        let watch = Stopwatch::start();
+        let ok = sys.chol.factorize(sys.kmat);
+        counters.totals.timings.factorization += watch.seconds();
+        counters.factorizations += 1;
+        if ok.is_err() {
+            return Err(Retry::NotFinite);
+        }
+    }
+    let watch = Stopwatch::start();
+    sys.chol.solve_in_place(&mut f);
+    counters.totals.timings.solve += watch.seconds();
+    if f.iter().any(|x| !x.is_finite()) {
+        return Err(Retry::NotFinite);
+    }
+    Ok(f)
+}
+
+/// d_n and N of every contact (5.4), (5.6) for the solution `d`, and the convergence tests
+/// (P23) and (P24); an unchanged zero force vector counts as converged.
+fn measure(p: &SolverParams, dn_max: f64, d: &[f64], active: &mut [Active]) -> (bool, bool) {
+    let mut max_dn: f64 = 0.0;
+    let (mut dl2, mut l2) = (0.0, 0.0);
+    for c in active.iter_mut() {
+        let (i, j) = c.blocks();
+        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+        let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
+        c.dn = c.kin.d0 + c.kin.g_i.dot(&di) + c.kin.g_j.dot(&dj);
+        if c.rec.state == ContactState::Open {
+            continue;
+        }
+        let lambda = if p.method == Method::Alm {
+            c.rec.lambda
+        } else {
+            0.0
+        };
+        c.force = lambda + c.rec.penalty * c.dn;
+        max_dn = max_dn.max(c.dn.abs());
+        if p.method == Method::Alm {
+            let new = c.force.max(0.0);
+            dl2 += (new - c.rec.lambda).powi(2);
+            l2 += c.rec.lambda.powi(2);
+        }
+    }
+    let conv1 = max_dn <= p.contact.eps1 * dn_max;
+    let conv2 = dl2 == 0.0 || dl2.sqrt() < p.contact.eps2 * l2.sqrt();
+    (conv1, conv2)
+}
+
+/// (P1) λ_k = λ_{k−1} + p_n d_n, kept non-negative, for every closed contact; and (P21): the
+/// penalty of a contact whose penetration does not fall fast enough is raised. Returns whether
+/// a penalty changed (K must be refactorized).
+fn update_multipliers(
+    cp: &ContactParams,
+    dn_max: f64,
+    alm_k: u32,
+    converged: bool,
+    active: &mut [Active],
+) -> bool {
+    let mut raised = false;
+    for c in active.iter_mut() {
+        if c.rec.state == ContactState::Open {
+            continue;
+        }
+        c.rec.lambda = c.force.max(0.0);
+        // Not for a contact whose penetration is already negligible against the tolerance
+        // ε1·d_n,max: there the ratio test only sees round-off, and over many steps it
+        // ratcheted every penalty of a standing wall up to γE, a stiffness that turned a 4 µm
+        // motion into meganewtons at the next impact.
+        if let Some(prev) = c.dn_prev
+            && alm_k <= PENALTY_ROUNDS + 1
+            && !converged
+            && c.dn.abs() > cp.beta * prev.abs()
+            && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * dn_max
+        {
+            let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
+            if capped > c.rec.penalty {
+                // Keep the shear spring's force as its stiffness (p_τ ∝ p_n) grows: shorten
+                // the spring instead, so that no energy is created.
+                let shrink = cp.shear_penalty(c.rec.penalty) / cp.shear_penalty(capped);
+                let delta = c.cand.xa - c.rec.reference;
+                c.rec.reference = c.cand.xa - delta * shrink;
+                c.rec.penalty = capped;
+                raised = true;
+            }
+        }
+        c.dn_prev = Some(c.dn);
+    }
+    raised
+}
+
+/// A sliding contact whose slip has reversed is in the wrong state, and its friction, from
+/// λ_{k−1} (5.8), can feed back: where friction presses blocks into other contacts (a wedge) the
+/// loop λ → friction → λ grew ×1.4 an iteration in a struck wall, reaching metres of
+/// displacement within 20 iterations, and the open–close check then classified every contact
+/// from that solution. The friction of such a contact is held at its present value for the rest
+/// of the pass (a change of F only: no refactorization); the open–close check locks it.
+fn hold_reversed_friction(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
+    for c in active.iter_mut() {
+        if c.rec.state != ContactState::Slide || c.frozen || c.friction_cap.is_some() {
+            continue;
+        }
+        let du = c.relative_displacement(d, inp.blocks);
+        if law::reversed(&du, &c.rec.tau, inp.slip_tolerance) {
+            c.friction_cap = Some(c.rec.lambda);
+        }
+    }
+}

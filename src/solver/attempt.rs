@@ -1,0 +1,133 @@
+//! One attempt at a step of length Δt: the open–close iteration around the ALM loop (paper
+//! Fig. 3), then the step-size checks. A failed attempt tells why ([`Retry`]); the solver then
+//! redoes the step with a shorter Δt.
+
+use super::active::Active;
+use super::alm::{AlmInputs, System, alm_loop};
+use super::assemble::{StiffnessSync, block_terms};
+use super::counters::{Counters, Stopwatch};
+use super::open_close::{self, CheckInputs};
+use super::step_control::{self, Retry};
+use crate::contact::law::LawParams;
+use crate::model::Block;
+use crate::params::{Method, SolverParams};
+use crate::physics::linear::{BlockMatrix, SparseCholesky};
+
+/// What an attempt reads.
+pub(crate) struct AttemptInputs<'a> {
+    pub params: &'a SolverParams,
+    pub blocks: &'a [Block],
+    /// Shi's w0: half the largest extent of the initial model, m.
+    pub w0: f64,
+    pub time: f64,
+    pub dt: f64,
+    /// The step is at the Δt floor: stragglers at the pass limit are settled, not redone.
+    pub at_floor: bool,
+}
+
+/// The solution of one attempt at a step.
+pub(crate) struct Solved {
+    pub d: Vec<f64>,
+    pub oc_passes: u32,
+    pub solves: u32,
+    /// The open–close iteration hit its limit and was settled.
+    pub settled: bool,
+}
+
+/// Runs one attempt. `kmat` holds the step's sparsity pattern.
+pub(crate) fn attempt(
+    inp: &AttemptInputs,
+    kmat: &mut BlockMatrix,
+    chol: &mut SparseCholesky,
+    active: &mut [Active],
+    counters: &mut Counters,
+) -> Result<Solved, Retry> {
+    let result = open_close_iteration(inp, kmat, chol, active, counters);
+    counters.flush();
+    let solved = result?;
+    step_control::check_solution(inp.params, inp.blocks, inp.w0, &solved.d, active)?;
+    Ok(solved)
+}
+
+/// The open–close passes, each an ALM loop followed by the open–close check, until no contact
+/// changes state. If the iteration has not converged after its pass limit, the attempt is
+/// redone with a shorter Δt (Shi); at the Δt floor, or where the stragglers are few, they are
+/// settled for one more solve instead (see [`open_close::settle_stragglers`]).
+fn open_close_iteration(
+    inp: &AttemptInputs,
+    kmat: &mut BlockMatrix,
+    chol: &mut SparseCholesky,
+    active: &mut [Active],
+    counters: &mut Counters,
+) -> Result<Solved, Retry> {
+    let p = inp.params;
+    let cp = &p.contact;
+    let watch = Stopwatch::start();
+    // (K0, F0): the block terms of §3, fixed for the attempt.
+    let (k0, f0) = block_terms(p, inp.blocks, inp.dt);
+    counters.assembly += watch.elapsed();
+    let law = LawParams {
+        close_penetration: cp.close_threshold * inp.w0,
+        open_tension: cp.initial_penalty * (cp.open_threshold * inp.w0),
+        slip_tolerance: cp.open_threshold * inp.w0,
+        tan_phi: p.joint.friction_angle.to_radians().tan(),
+        eps2: cp.eps2,
+    };
+    for c in active.iter_mut() {
+        c.flips = 0;
+        c.frozen = false;
+    }
+    let mut sync = StiffnessSync::default();
+    let mut solved = Solved {
+        d: Vec::new(),
+        oc_passes: 0,
+        solves: 0,
+        settled: false,
+    };
+    for pass in 0..=cp.max_open_close_iterations {
+        if pass == cp.max_open_close_iterations {
+            open_close::settle_stragglers(active, law.close_penetration, inp.at_floor, counters)?;
+            solved.settled = true;
+        }
+        solved.oc_passes += 1;
+        let alm = AlmInputs {
+            params: p,
+            blocks: inp.blocks,
+            k0: &k0,
+            f0: &f0,
+            dn_max: 2.0 * p.max_displacement_ratio * inp.w0,
+            slip_tolerance: law.slip_tolerance,
+            settling: solved.settled,
+        };
+        let mut sys = System {
+            kmat,
+            sync: &mut sync,
+            chol,
+        };
+        let out = alm_loop(&alm, &mut sys, active, counters)?;
+        solved.d = out.d;
+        solved.solves += out.solves;
+        if !out.converged {
+            counters.totals.alm_cap_hits += 1;
+        }
+        if solved.settled {
+            break;
+        }
+        let watch = Stopwatch::start();
+        let check = CheckInputs {
+            params: p,
+            blocks: inp.blocks,
+            law,
+            warm: cp.warm_start && p.method == Method::Alm,
+            time: inp.time,
+            dt: inp.dt,
+            pass: solved.oc_passes,
+        };
+        let changed = open_close::check(&check, &solved.d, active, counters);
+        counters.assembly += watch.elapsed();
+        if !changed {
+            break;
+        }
+    }
+    Ok(solved)
+}

@@ -1,0 +1,157 @@
+//! The last stage of a step: accept the solution. The contacts' records move with block j into
+//! the next step and the closed ones are published; the blocks take their new velocities (3.2),
+//! stresses and strains, and their vertices move by the finite-rotation update (1.3).
+
+use std::collections::HashMap;
+
+use super::active::Active;
+use crate::contact::record::ContactRecord;
+use crate::contact::{ContactKey, ContactState};
+use crate::model::Block;
+use crate::params::{Method, SolverParams};
+use crate::physics::geometry::Vec3;
+use crate::physics::mechanics::{StepMap, Vec12, rotate_stress};
+use crate::snapshot::{ContactSnapshot, StepStats};
+
+/// The end-of-step map of every block's material points for the solution `d`.
+pub(crate) fn step_maps(blocks: &[Block], d: &[f64]) -> Vec<StepMap> {
+    blocks
+        .iter()
+        .enumerate()
+        .map(|(i, b)| {
+            let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+            StepMap::new(b.mp.centroid, &di)
+        })
+        .collect()
+}
+
+/// The records every contact carries into the next step, and the closed contacts as published.
+/// Contact outputs use the start-of-step geometry moved by the step.
+pub(crate) fn commit_contacts(
+    p: &SolverParams,
+    maps: &[StepMap],
+    active: &[Active],
+) -> (HashMap<ContactKey, ContactRecord>, Vec<ContactSnapshot>) {
+    let tan_phi = p.joint.friction_angle.to_radians().tan();
+    let mut contacts = Vec::new();
+    let mut records = HashMap::with_capacity(active.len());
+    for c in active {
+        let mut rec = c.rec;
+        let closed = rec.state.is_closed();
+        rec.penetration = c.dn + rec.overlap;
+        if closed {
+            rec.normal_force = c.force;
+            rec.shear_force = match rec.state {
+                ContactState::Lock => p.contact.shear_penalty(rec.penalty) * c.shear.norm(),
+                _ => {
+                    let n_prev = if p.method == Method::Alm {
+                        rec.lambda
+                    } else {
+                        rec.normal_force.max(0.0)
+                    };
+                    n_prev * tan_phi
+                }
+            };
+        } else {
+            rec.normal_force = 0.0;
+            rec.shear_force = 0.0;
+        }
+        let mj = &maps[c.cand.key.j as usize];
+        rec.reference = mj.apply(&rec.reference);
+        rec.tau = mj.rotation() * rec.tau;
+        if closed {
+            contacts.push(ContactSnapshot {
+                block_i: c.cand.key.i as usize,
+                block_j: c.cand.key.j as usize,
+                mode: c.cand.mode(),
+                state: rec.state,
+                point: mj.apply(&c.cand.xb).into(),
+                normal: (mj.rotation() * c.cand.normal).into(),
+                normal_force: rec.normal_force,
+                shear_force: rec.shear_force,
+                penetration: c.dn + rec.overlap,
+                penalty: rec.penalty,
+                lambda: if p.method == Method::Alm {
+                    rec.lambda
+                } else {
+                    0.0
+                },
+            });
+        }
+        records.insert(c.cand.key, rec);
+    }
+    (records, contacts)
+}
+
+/// Moves every block by its solution: velocity (3.2) v1 = 2D/Δt − v0, stress and strain, and the
+/// vertices and load points by the finite-rotation map (1.3).
+pub(crate) fn commit_blocks(
+    p: &SolverParams,
+    blocks: &mut [Block],
+    maps: &[StepMap],
+    d: &[f64],
+    dt: f64,
+) {
+    for (i, b) in blocks.iter_mut().enumerate() {
+        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+        b.velocity = di * (2.0 / dt) - b.velocity;
+        let de = di.fixed_rows::<6>(6).into_owned();
+        let map = &maps[i];
+        if p.rotate_stress {
+            b.stress = rotate_stress(&b.stress, map.rotation());
+        }
+        b.stress += b.elasticity * de;
+        b.strain += de;
+        for v in &mut b.vertices {
+            *v = map.apply(v);
+        }
+        // Point loads are dead loads: the point moves with the block, the force keeps its
+        // direction in space (as in Shi's code).
+        for (pt, _) in &mut b.loads {
+            *pt = map.apply(pt);
+        }
+        b.refresh();
+    }
+}
+
+/// The step's statistics from its contacts: the largest penetration and kept overlap of a
+/// closed contact, and the contacts by state.
+pub(crate) fn contact_stats(active: &[Active], closed: &[ContactSnapshot]) -> StepStats {
+    let count = |s: ContactState| closed.iter().filter(|c| c.state == s).count() as u32;
+    StepStats {
+        max_penetration: active
+            .iter()
+            .filter(|c| c.rec.state.is_closed())
+            .map(|c| c.dn)
+            .fold(0.0, f64::max),
+        max_overlap: active
+            .iter()
+            .filter(|c| c.rec.state.is_closed())
+            .map(|c| c.rec.overlap)
+            .fold(0.0, f64::max),
+        contacts_lock: count(ContactState::Lock),
+        contacts_slide: count(ContactState::Slide),
+        contacts_open: (active.len() - closed.len()) as u32,
+        ..Default::default()
+    }
+}
+
+/// Kinetic, gravitational and elastic energy of the model, into `s`.
+pub(crate) fn with_energy(mut s: StepStats, blocks: &[Block], gravity: [f64; 3]) -> StepStats {
+    let g = Vec3::from(gravity);
+    s.kinetic_energy = blocks
+        .iter()
+        .filter(|b| !b.fixed)
+        .map(Block::kinetic_energy)
+        .sum();
+    s.potential_energy = blocks
+        .iter()
+        .filter(|b| !b.fixed)
+        .map(|b| -b.mass * g.dot(&b.mp.centroid))
+        .sum();
+    s.elastic_energy = blocks
+        .iter()
+        .map(|b| 0.5 * b.mp.volume * b.stress.dot(&b.strain))
+        .sum();
+    s
+}

@@ -1,0 +1,297 @@
+//! The DDA-3a / DDA-3p time stepper. A step runs through its stages in order, each a function
+//! that takes what it reads and returns or changes what it owns:
+//!
+//! 1. [`activate`]: detect the contacts and attach their records (reference §4);
+//! 2. [`assemble`]: the step's sparsity pattern, the block terms (K0, F0) and the contact terms;
+//! 3. [`attempt`]: the open–close iteration ([`open_close`]) around the ALM loop ([`alm`]),
+//!    paper Fig. 3, then the step-size checks;
+//! 4. [`step_control`]: Δt predicted, cut when an attempt fails, grown back after a step;
+//! 5. [`commit`]: the solution becomes the new state, and the contacts' records move on.
+//!
+//! [`counters`] times the stages and counts iterations for `summary.json`. What leaves the
+//! solver is plain data: [`Snapshot`], [`StepStats`] and [`RunTotals`].
+
+mod activate;
+mod active;
+mod alm;
+mod assemble;
+mod attempt;
+mod commit;
+mod counters;
+mod open_close;
+mod step_control;
+
+use std::collections::HashMap;
+
+use activate::{ActivationInputs, activate};
+use active::Active;
+use attempt::{AttemptInputs, Solved, attempt};
+use counters::{Counters, Stopwatch, debug_log};
+
+use crate::contact::ContactKey;
+use crate::contact::record::ContactRecord;
+use crate::model::Model;
+use crate::params::{Mode, SolverParams};
+use crate::physics::geometry::bounding_box;
+use crate::physics::linear::{BlockMatrix, SparseCholesky};
+use crate::physics::mechanics::Vec12;
+use crate::snapshot::{BlockSnapshot, ContactSnapshot, RunTotals, Snapshot, StepStats};
+
+/// A run that cannot go on.
+#[derive(Debug, Clone, thiserror::Error)]
+pub enum SolverError {
+    #[error("diverged at t = {time:.6} s: {reason}")]
+    Diverged { time: f64, reason: String },
+}
+
+/// What the global system keeps from one step to the next.
+#[derive(Default)]
+struct LinearCache {
+    /// Block pairs of the last step's sparsity pattern (a < b).
+    pattern: Vec<(usize, usize)>,
+    /// The factorization, with its symbolic analysis reused while the pattern holds.
+    chol: SparseCholesky,
+}
+
+/// Steps a [`Model`] through time.
+pub struct Solver {
+    pub params: SolverParams,
+    pub model: Model,
+    /// Simulated time, s.
+    pub time: f64,
+    /// Completed steps.
+    pub step: u64,
+    /// The step length the next step starts from (before prediction), s.
+    dt: f64,
+    /// Half the largest extent of the initial model (Shi's w0), m.
+    w0: f64,
+    /// What each contact carries to the next step.
+    records: HashMap<ContactKey, ContactRecord>,
+    linear: LinearCache,
+    /// Closed contacts after the last step.
+    contacts: Vec<ContactSnapshot>,
+    /// Statistics of the last step.
+    pub last: StepStats,
+    pub totals: RunTotals,
+    /// Contacts summed over all steps (for `contacts_per_step`).
+    contact_sum: u64,
+}
+
+impl Solver {
+    pub fn new(model: Model, params: SolverParams) -> Self {
+        let all: Vec<_> = model
+            .blocks
+            .iter()
+            .flat_map(|b| b.vertices.iter().copied())
+            .collect();
+        let (lo, hi) = bounding_box(&all);
+        let w0 = 0.5 * (hi - lo).max();
+        let last = commit::with_energy(StepStats::default(), &model.blocks, params.gravity);
+        Solver {
+            dt: params.max_time_step,
+            params,
+            model,
+            time: 0.0,
+            step: 0,
+            w0,
+            records: HashMap::new(),
+            linear: LinearCache::default(),
+            contacts: Vec::new(),
+            last,
+            totals: RunTotals::default(),
+            contact_sum: 0,
+        }
+    }
+
+    pub fn w0(&self) -> f64 {
+        self.w0
+    }
+
+    /// d_n,max = 2 δ w0 of (P22).
+    pub fn max_step_penetration(&self) -> f64 {
+        2.0 * self.params.max_displacement_ratio * self.w0
+    }
+
+    pub fn finished(&self) -> bool {
+        self.time >= self.params.duration - 1e-9 * self.params.max_time_step
+    }
+
+    /// Advances one step, never past `duration`.
+    pub fn step(&mut self) -> Result<&StepStats, SolverError> {
+        self.step_until(self.params.duration)
+    }
+
+    /// Advances one step without passing `limit` (so that outputs land on requested times).
+    pub fn step_until(&mut self, limit: f64) -> Result<&StepStats, SolverError> {
+        let limit = limit.min(self.params.duration);
+        let watch = Stopwatch::start();
+        if self.params.mode == Mode::Static {
+            for b in &mut self.model.blocks {
+                b.velocity = Vec12::zeros();
+            }
+        }
+        let (mut active, mut kmat) = self.detect();
+        self.totals.timings.detection += watch.seconds();
+
+        let predicted = step_control::predict_dt(&self.params, &self.model.blocks, self.w0);
+        let base = self.dt.min(predicted);
+        let first = step_control::first_attempt(base, limit - self.time);
+        let (solved, dt, cuts, factorizations) = self.solve(&mut kmat, &mut active, first)?;
+
+        let watch = Stopwatch::start();
+        let maps = commit::step_maps(&self.model.blocks, &solved.d);
+        let (records, contacts) = commit::commit_contacts(&self.params, &maps, &active);
+        self.records = records;
+        self.contacts = contacts;
+        commit::commit_blocks(&self.params, &mut self.model.blocks, &maps, &solved.d, dt);
+        self.time += dt;
+        self.step += 1;
+        self.totals.timings.bookkeeping += watch.seconds();
+
+        let stats = StepStats {
+            time_step: dt,
+            open_close_iterations: solved.oc_passes,
+            alm_iterations: solved.solves,
+            time_step_cuts: cuts,
+            factorizations,
+            ..commit::contact_stats(&active, &self.contacts)
+        };
+        self.count(&stats, active.len());
+        self.last = commit::with_energy(stats, &self.model.blocks, self.params.gravity);
+        if debug_log() {
+            let l = &self.last;
+            eprintln!(
+                "step t={:.4} dt={dt:.2e} kinetic={:.4e} potential={:.6e} elastic={:.4e} passes={} factorizations={factorizations}",
+                self.time,
+                l.kinetic_energy,
+                l.potential_energy,
+                l.elastic_energy,
+                l.open_close_iterations
+            );
+        }
+        self.dt = step_control::next_dt(&self.params, base, dt, cuts);
+        Ok(&self.last)
+    }
+
+    /// Stage 1: this step's contacts, and the global matrix laid out on their pattern.
+    fn detect(&mut self) -> (Vec<Active>, BlockMatrix) {
+        let (mut active, near) = activate(&ActivationInputs {
+            params: &self.params,
+            blocks: &self.model.blocks,
+            records: &self.records,
+            w0: self.w0,
+            step: self.step,
+            time: self.time,
+        });
+        let pairs = assemble::sparsity_pattern(&active, &self.linear.pattern, &near);
+        self.linear.pattern = pairs.clone();
+        let kmat = BlockMatrix::new(self.model.blocks.len(), pairs);
+        for c in &mut active {
+            c.pair = kmat
+                .pair_index(c.cand.key.i as usize, c.cand.key.j as usize)
+                .expect("pattern holds every contact pair");
+        }
+        (active, kmat)
+    }
+
+    /// Stages 2–4: attempts at the step from Δt = `first`, cut after each failure, until one
+    /// is accepted. Returns the solution, the step taken, the cuts and the factorizations.
+    fn solve(
+        &mut self,
+        kmat: &mut BlockMatrix,
+        active: &mut [Active],
+        first: f64,
+    ) -> Result<(Solved, f64, u32, u32), SolverError> {
+        let floor = step_control::dt_floor(&self.params);
+        let mut counters = Counters::new(&mut self.totals);
+        let mut dt = first;
+        let mut cuts = 0u32;
+        loop {
+            let at_floor = dt <= floor * (1.0 + 1e-9);
+            let inputs = AttemptInputs {
+                params: &self.params,
+                blocks: &self.model.blocks,
+                w0: self.w0,
+                time: self.time,
+                dt,
+                at_floor,
+            };
+            match attempt(&inputs, kmat, &mut self.linear.chol, active, &mut counters) {
+                Ok(solved) => {
+                    counters.totals.unconverged_steps += solved.settled as u64;
+                    return Ok((solved, dt, cuts, counters.factorizations));
+                }
+                Err(reason) if at_floor => {
+                    return Err(SolverError::Diverged {
+                        time: self.time,
+                        reason: reason.divergence(),
+                    });
+                }
+                Err(reason) => {
+                    if debug_log() {
+                        eprintln!(
+                            "cut at t={:.4} dt={dt:.2e}: {}",
+                            self.time,
+                            reason.describe()
+                        );
+                    }
+                    dt = reason.shortened(dt, floor);
+                    cuts += 1;
+                    for c in active.iter_mut() {
+                        c.rec = c.start;
+                    }
+                }
+            }
+        }
+    }
+
+    /// Adds a completed step to the run's totals.
+    fn count(&mut self, s: &StepStats, contacts: usize) {
+        let t = &mut self.totals;
+        t.steps += 1;
+        t.open_close_iterations += s.open_close_iterations as u64;
+        t.alm_iterations += s.alm_iterations as u64;
+        t.time_step_cuts += s.time_step_cuts as u64;
+        t.factorizations += s.factorizations as u64;
+        t.symbolic_analyses = self.linear.chol.symbolic_count;
+        t.max_penetration = t.max_penetration.max(s.max_penetration);
+        t.max_overlap = t.max_overlap.max(s.max_overlap);
+        self.contact_sum += contacts as u64;
+        t.contacts_per_step = self.contact_sum as f64 / t.steps as f64;
+    }
+
+    /// The state now, as plain data.
+    pub fn snapshot(&self) -> Snapshot {
+        Snapshot {
+            scene_name: self.model.name.clone(),
+            time: self.time,
+            step: self.step,
+            blocks: self
+                .model
+                .blocks
+                .iter()
+                .map(|b| BlockSnapshot {
+                    name: b.name.clone(),
+                    fixed: b.fixed,
+                    vertices: b.vertices.iter().map(|v| (*v).into()).collect(),
+                    faces: b
+                        .topo
+                        .faces
+                        .iter()
+                        .map(|f| f.iter().map(|&k| k as u32).collect())
+                        .collect(),
+                    centroid: b.mp.centroid.into(),
+                    velocity: [b.velocity[0], b.velocity[1], b.velocity[2]],
+                    displacement: (b.mp.centroid - b.initial_centroid).into(),
+                })
+                .collect(),
+            contacts: self.contacts.clone(),
+            stats: self.last.clone(),
+        }
+    }
+
+    /// Closed contacts after the last step.
+    pub fn contacts(&self) -> &[ContactSnapshot] {
+        &self.contacts
+    }
+}

@@ -1,0 +1,183 @@
+//! The open–close check (reference §6.1): after each ALM loop, every contact is classified by
+//! the contact law ([`crate::contact::law`]) from the solution, and the pass is repeated until
+//! no contact changes state. Contacts that keep cycling are settled; at the pass limit the
+//! stragglers are settled or the attempt is redone.
+
+use super::active::Active;
+use super::counters::{Counters, debug_log};
+use super::step_control::Retry;
+use crate::contact::ContactState;
+use crate::contact::law::{self, LawParams, Observation, Transition};
+use crate::model::Block;
+use crate::params::SolverParams;
+use crate::params::step_rules::SETTLE_FRACTION;
+use crate::physics::geometry::Vec3;
+
+/// State changes a contact may make in one attempt before it is settled.
+const MAX_FLIPS: u8 = 2;
+
+/// What the check of one pass reads.
+pub(crate) struct CheckInputs<'a> {
+    pub params: &'a SolverParams,
+    pub blocks: &'a [Block],
+    pub law: LawParams,
+    /// Warm start in effect (ALM with `warm_start`): a contact closed at the start of the step
+    /// and reopened in an earlier pass keeps its adapted penalty when it closes again.
+    pub warm: bool,
+    /// For the debug log.
+    pub time: f64,
+    pub dt: f64,
+    pub pass: u32,
+}
+
+/// Classifies every contact from the solution `d` and applies the verdicts. Returns whether a
+/// contact changed state (another pass is needed).
+pub(crate) fn check(
+    inp: &CheckInputs,
+    d: &[f64],
+    active: &mut [Active],
+    counters: &mut Counters,
+) -> bool {
+    let mut changed = false;
+    for c in active.iter_mut() {
+        c.changed = false;
+        let n = c.cand.normal;
+        let du = c.relative_displacement(d, inp.blocks);
+        c.slip = du - n * n.dot(&du);
+        if c.frozen {
+            c.rec.normal_force = c.force;
+            continue;
+        }
+        let before = c.rec.state;
+        classify_and_apply(inp, c, &du);
+        if c.rec.state == before {
+            continue;
+        }
+        if debug_log() {
+            log_change(inp, c, before);
+        }
+        changed = true;
+        c.changed = true;
+        c.flips += 1;
+        if c.flips > MAX_FLIPS {
+            // A contact that keeps cycling (typically an edge–edge and a vertex–face contact
+            // of one block pair taking the load in turn) is settled for the rest of the
+            // attempt (see `law::Settled`).
+            c.settle(inp.law.close_penetration);
+            counters.totals.frozen_contacts += (before != c.rec.state) as u64;
+            c.flips = 0;
+            c.frozen = true;
+        }
+    }
+    changed
+}
+
+/// The contact law's verdict on one contact, applied to its record.
+fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
+    let cp = &inp.params.contact;
+    let closed = c.rec.state.is_closed();
+    if closed {
+        c.rec.normal_force = c.force;
+    }
+    // The shear spring's extension N(Δ + Δu_ab) of a locked contact.
+    let shear = if c.rec.state == ContactState::Lock {
+        let n = c.cand.normal;
+        let r = (c.cand.xa - c.rec.reference) + du;
+        r - n * n.dot(&r)
+    } else {
+        Vec3::zeros()
+    };
+    let seen = Observation {
+        state: c.rec.state,
+        penetration: c.dn,
+        normal_force: c.force,
+        shear,
+        shear_stiffness: cp.shear_penalty(c.rec.penalty),
+        cohesion: if c.rec.intact {
+            inp.params.joint.cohesion * c.rec.cohesion_area
+        } else {
+            0.0
+        },
+        slip: c.slip,
+        tau: c.rec.tau,
+        lambda: c.rec.lambda,
+        held_friction: c.friction_cap,
+    };
+    let verdict = law::classify(&seen, &inp.law);
+    if c.rec.state == ContactState::Lock && verdict != Transition::Open {
+        c.shear = shear;
+    }
+    match verdict {
+        Transition::Keep => {}
+        Transition::Close => {
+            c.rec.state = ContactState::Lock;
+            c.rec.reference = c.cand.xb;
+            c.rec.lambda = 0.0;
+            // A new contact starts at p_n,1 (§6.1). One that was closed at the start of the
+            // step and only opened in an earlier pass is not new: it keeps its adapted penalty,
+            // which spares the (P21) rounds, and their factorizations, of raising it again.
+            c.rec.penalty = if c.start.state.is_closed() && inp.warm {
+                c.start.penalty
+            } else {
+                cp.initial_penalty
+            };
+            c.rec.normal_force = 0.0;
+        }
+        Transition::Open => {
+            c.rec.state = ContactState::Open;
+            c.rec.lambda = 0.0;
+            c.rec.intact = false;
+        }
+        Transition::Slide { tau } => {
+            c.rec.state = ContactState::Slide;
+            c.rec.tau = tau;
+            c.rec.intact = false;
+        }
+        Transition::Stick => {
+            c.rec.state = ContactState::Lock;
+            c.rec.reference = c.cand.xb;
+        }
+        Transition::Turn { tau } => c.rec.tau = tau,
+    }
+}
+
+/// At the open–close pass limit: if more than [`SETTLE_FRACTION`] of the contacts still changed
+/// in the last pass (and the step is above the Δt floor), the attempt is redone with a shorter
+/// step (Shi). Otherwise, and always at the floor, the contacts that still changed are settled
+/// closed and locked for one more solve, and the step is accepted.
+pub(crate) fn settle_stragglers(
+    active: &mut [Active],
+    close_tol: f64,
+    at_floor: bool,
+    counters: &mut Counters,
+) -> Result<(), Retry> {
+    let stragglers = active.iter().filter(|c| c.changed).count() as f64;
+    if !at_floor && stragglers > SETTLE_FRACTION * active.len() as f64 {
+        return Err(Retry::OpenClose);
+    }
+    for c in active.iter_mut().filter(|c| c.changed) {
+        c.settle(close_tol);
+        counters.totals.frozen_contacts += 1;
+    }
+    Ok(())
+}
+
+/// `DDA3D_DEBUG=1`: one line per state change.
+fn log_change(inp: &CheckInputs, c: &Active, before: ContactState) {
+    eprintln!(
+        "t={:.4} dt={:.2e} pass {}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} pair={}-{}",
+        inp.time,
+        inp.dt,
+        inp.pass,
+        before,
+        c.rec.state,
+        c.cand.key.mode,
+        c.force,
+        c.dn,
+        c.rec.penalty,
+        c.shear.norm(),
+        c.slip.norm(),
+        c.cand.key.i,
+        c.cand.key.j
+    );
+}

@@ -1,0 +1,199 @@
+//! Step control (reference §6.3, §8): the predicted Δt, the checks of a solved attempt
+//! (displacement within δ·w0, penetration within the contact window), what a failed attempt is
+//! retried with, and how Δt grows back. The numbers are Shi's rules in
+//! [`crate::params::step_rules`].
+
+use super::active::Active;
+use crate::contact::DetectionParams;
+use crate::model::Block;
+use crate::params::step_rules::{
+    DISPLACEMENT_CUT_SAFETY, DT_CUT, DT_FLOOR_DIVISOR, DT_GROWTH, PREDICT_SAFETY,
+};
+use crate::params::{Mode, SolverParams};
+use crate::physics::geometry::Vec3;
+use crate::physics::mechanics::{Vec12, displacement_matrix};
+
+/// Why an attempt at a step failed and must be redone with a shorter Δt.
+pub(crate) enum Retry {
+    /// The open–close iteration did not converge within its pass limit.
+    OpenClose,
+    /// The largest vertex displacement was this many times δ·w0.
+    Displacement(f64),
+    /// A closed contact penetrated this deep, m, beyond the contact window.
+    Penetration(f64),
+    /// The factorization failed or the solution is not finite.
+    NotFinite,
+}
+
+impl Retry {
+    /// The reason a run diverges when this failure happens at the Δt floor.
+    pub fn divergence(&self) -> String {
+        match self {
+            Retry::OpenClose => unreachable!("settled at the floor"),
+            Retry::NotFinite => "the solution is not finite".to_string(),
+            Retry::Penetration(p) => {
+                format!("penetration {p:.3e} m exceeds the contact window at the minimum time step")
+            }
+            Retry::Displacement(r) => format!(
+                "vertex displacement {r:.1} times the allowed δ·w0 at the minimum time step"
+            ),
+        }
+    }
+
+    /// A short description for the debug log.
+    pub fn describe(&self) -> String {
+        match self {
+            Retry::OpenClose => "open-close".to_string(),
+            Retry::Displacement(r) => format!("displacement r={r:.2}"),
+            Retry::Penetration(p) => format!("penetration {p:.2e}"),
+            Retry::NotFinite => "not finite".to_string(),
+        }
+    }
+
+    /// The Δt of the next attempt: cut by [`DT_CUT`], or for too large a displacement by the
+    /// square root of the excess (a step's displacement grows as Δt²), never below the floor.
+    pub fn shortened(&self, dt: f64, floor: f64) -> f64 {
+        match self {
+            Retry::Displacement(r) => dt / r.sqrt() * DISPLACEMENT_CUT_SAFETY,
+            _ => dt * DT_CUT,
+        }
+        .max(floor)
+    }
+}
+
+/// The smallest step, Δt_max / [`DT_FLOOR_DIVISOR`]; a step that fails there diverges.
+pub(crate) fn dt_floor(p: &SolverParams) -> f64 {
+    p.max_time_step / DT_FLOOR_DIVISOR
+}
+
+/// The first attempt's Δt: `base`, shortened to land on the time limit when `remaining` is
+/// within one step of it, and split in two when it is within two (so that no sliver of a step
+/// is left before the target time).
+pub(crate) fn first_attempt(base: f64, remaining: f64) -> f64 {
+    if remaining <= base * (1.0 + 1e-9) {
+        remaining
+    } else if remaining < 2.0 * base {
+        remaining / 2.0
+    } else {
+        base
+    }
+}
+
+/// The next step's Δt: grows back by at most [`DT_GROWTH`] a step (Shi), up to Δt_max. A step
+/// shortened only to land on a time limit does not hold the next one back, so growth starts
+/// from the predicted `base` unless the step was cut.
+pub(crate) fn next_dt(p: &SolverParams, base: f64, taken: f64, cuts: u32) -> f64 {
+    let grown_from = if cuts > 0 { taken } else { base };
+    (grown_from * DT_GROWTH).min(p.max_time_step)
+}
+
+/// Δt such that the fastest vertex moves at most δ·w0 under its current velocity and gravity
+/// (Shi's prediction from ½ a Δt² + v Δt = δ w0).
+pub(crate) fn predict_dt(p: &SolverParams, blocks: &[Block], w0: f64) -> f64 {
+    let allowed = p.max_displacement_ratio * w0 * PREDICT_SAFETY;
+    let a = Vec3::from(p.gravity).norm().max(1e-12);
+    let mut dt = p.max_time_step;
+    if p.mode == Mode::Static {
+        return dt;
+    }
+    let search = DetectionParams::new(w0, p.max_displacement_ratio).search_distance;
+    for (i, b) in blocks.iter().enumerate().filter(|(_, b)| !b.fixed) {
+        let v = &b.velocity;
+        let r = b.radius();
+        let speed = Vec3::new(v[0], v[1], v[2]).norm()
+            + Vec3::new(v[3], v[4], v[5]).norm() * r
+            + v.fixed_rows::<6>(6).norm() * r;
+        let t = (-speed + (speed * speed + 2.0 * a * allowed).sqrt()) / a;
+        if t < dt {
+            let dt_max = p.max_time_step;
+            let reach = speed * dt_max + 0.5 * a * dt_max * dt_max + search;
+            if isolated(blocks, i, reach) {
+                continue;
+            }
+            dt = t;
+        }
+    }
+    dt.max(dt_floor(p))
+}
+
+/// True when no other block comes within `reach` of block `i`'s bounding box: a block in free
+/// flight. The constant-acceleration step integrates its motion exactly, and δ·w0, which keeps
+/// the contact linearisation and the detection window valid, need not limit its step. (A rock
+/// that bounced off the ground slab's edge fell for 90 s at the Δt floor and was then reported
+/// as diverged.)
+pub(crate) fn isolated(blocks: &[Block], i: usize, reach: f64) -> bool {
+    let b = &blocks[i];
+    let (lo, hi) = (b.lo - Vec3::repeat(reach), b.hi + Vec3::repeat(reach));
+    blocks
+        .iter()
+        .enumerate()
+        .all(|(k, o)| k == i || (0..3).any(|d| o.hi[d] < lo[d] || o.lo[d] > hi[d]))
+}
+
+/// The step-size checks of a solved attempt: no vertex of a block in contact range moves more
+/// than `max_displacement_overshoot · δ·w0`, and no closed contact penetrates beyond the
+/// contact window d_pen.
+pub(crate) fn check_solution(
+    p: &SolverParams,
+    blocks: &[Block],
+    w0: f64,
+    d: &[f64],
+    active: &[Active],
+) -> Result<(), Retry> {
+    let allowed = p.max_displacement_ratio * w0;
+    let detection = DetectionParams::new(w0, p.max_displacement_ratio);
+    let mut max_u: f64 = 0.0;
+    for (i, b) in blocks.iter().enumerate() {
+        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+        let u = b
+            .vertices
+            .iter()
+            .map(|v| (displacement_matrix(&(v - b.mp.centroid)) * di).norm())
+            .fold(0.0, f64::max);
+        // A block in free flight may move further (see `isolated`).
+        if u > allowed && isolated(blocks, i, u + detection.search_distance) {
+            continue;
+        }
+        max_u = max_u.max(u);
+    }
+    let r = max_u / allowed;
+    if r > p.max_displacement_overshoot {
+        return Err(Retry::Displacement(r));
+    }
+    let worst = active
+        .iter()
+        .filter(|c| c.rec.state.is_closed())
+        .map(|c| c.dn)
+        .fold(0.0, f64::max);
+    if worst > detection.max_penetration {
+        return Err(Retry::Penetration(worst));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_first_attempt_lands_on_the_limit_without_a_sliver() {
+        assert_eq!(first_attempt(0.01, 1.0), 0.01);
+        assert_eq!(first_attempt(0.01, 0.01), 0.01);
+        assert_eq!(first_attempt(0.01, 0.004), 0.004);
+        // 1.5 steps left: two steps of 0.0075 s, not 0.01 s and a 0.005 s sliver.
+        assert_eq!(first_attempt(0.01, 0.015), 0.0075);
+    }
+
+    #[test]
+    fn a_failed_attempt_is_cut_and_the_next_step_grows_back() {
+        let p = SolverParams::default();
+        let floor = dt_floor(&p);
+        assert!((Retry::OpenClose.shortened(0.01, floor) - 0.003).abs() < 1e-15);
+        let by_4 = Retry::Displacement(4.0).shortened(0.01, floor);
+        assert!((by_4 - 0.01 / 2.0 * DISPLACEMENT_CUT_SAFETY).abs() < 1e-15);
+        assert_eq!(Retry::NotFinite.shortened(1.5 * floor, floor), floor);
+        assert!((next_dt(&p, 0.001, 0.0005, 0) - 0.0013).abs() < 1e-15);
+        assert!((next_dt(&p, 0.001, 0.0005, 1) - 0.00065).abs() < 1e-15);
+        assert_eq!(next_dt(&p, 0.009, 0.009, 0), p.max_time_step);
+    }
+}
