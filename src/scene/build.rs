@@ -1,0 +1,172 @@
+//! From the scene file's entries to the model: materials checked, each block's shape turned into
+//! a convex hull, and the blocks checked for overlap at the start. Messages here are the problem
+//! alone; [`super::parse`] adds the file, the line and the block's name.
+
+use super::format::BlockSpec;
+use crate::contact::Shape;
+use crate::contact::detection::broad_phase;
+use crate::model::Block;
+use crate::physics::geometry::{
+    Vec3, bounding_box, box_vertices, convex_hull, dodecahedron_vertices, overlap_depth,
+    prism_vertices, rotation_xyz_degrees,
+};
+use crate::physics::mechanics::Material;
+
+/// Checks a material's constants.
+pub(super) fn check_material(name: &str, m: &Material) -> Result<(), String> {
+    for (key, v) in [
+        ("density", m.density),
+        ("young_modulus", m.young_modulus),
+        ("poisson_ratio", m.poisson_ratio),
+    ] {
+        if !v.is_finite() {
+            return Err(format!("material '{name}': {key} is not a finite number"));
+        }
+    }
+    if m.density <= 0.0 {
+        return Err(format!(
+            "material '{name}': density must be positive, got {}",
+            m.density
+        ));
+    }
+    if m.young_modulus <= 0.0 {
+        return Err(format!(
+            "material '{name}': young_modulus must be positive, got {}",
+            m.young_modulus
+        ));
+    }
+    if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
+        return Err(format!(
+            "material '{name}': poisson_ratio must lie in (-1, 0.5), got {}",
+            m.poisson_ratio
+        ));
+    }
+    Ok(())
+}
+
+fn finite(v: &[f64]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+/// The points whose convex hull is the block: exactly one of `vertices`, `box`,
+/// `dodecahedron` or `prism`.
+fn shape_points(spec: &BlockSpec) -> Result<Vec<Vec3>, String> {
+    let given = [
+        spec.vertices.is_some(),
+        spec.box_.is_some(),
+        spec.dodecahedron.is_some(),
+        spec.prism.is_some(),
+    ]
+    .iter()
+    .filter(|&&b| b)
+    .count();
+    if given != 1 {
+        return Err("give exactly one of vertices, box, dodecahedron or prism".into());
+    }
+    if let Some(v) = &spec.vertices {
+        return Ok(v.iter().map(|p| Vec3::from(*p)).collect());
+    }
+    if let Some(b) = &spec.box_ {
+        if !finite(&b.size) || !finite(&b.center) || !finite(&b.rotation) {
+            return Err("box has a non-finite number".into());
+        }
+        if b.size.iter().any(|&s| s <= 0.0) {
+            return Err("box size must be positive".into());
+        }
+        return Ok(box_vertices(
+            b.size,
+            b.center,
+            &rotation_xyz_degrees(b.rotation),
+        ));
+    }
+    if let Some(d) = &spec.dodecahedron {
+        if !d.edge.is_finite() || !finite(&d.center) || !finite(&d.rotation) {
+            return Err("dodecahedron has a non-finite number".into());
+        }
+        if d.edge <= 0.0 {
+            return Err("dodecahedron edge must be positive".into());
+        }
+        return Ok(dodecahedron_vertices(
+            d.edge,
+            d.center,
+            &rotation_xyz_degrees(d.rotation),
+        ));
+    }
+    let p = spec.prism.as_ref().expect("one shape given");
+    if !finite(&p.extrude) || p.base.iter().any(|b| !finite(b)) {
+        return Err("prism has a non-finite number".into());
+    }
+    Ok(prism_vertices(&p.base, p.extrude))
+}
+
+/// One block from its `[[blocks]]` entry.
+pub(super) fn build_block(
+    spec: &BlockSpec,
+    name: String,
+    material: Material,
+) -> Result<Block, String> {
+    let points = shape_points(spec)?;
+    let (vertices, topo) = convex_hull(&points).map_err(|e| e.to_string())?;
+    if !finite(&spec.velocity) || !finite(&spec.angular_velocity) {
+        return Err("velocity is not finite".into());
+    }
+    let mut loads = Vec::new();
+    for l in &spec.loads {
+        if !finite(&l.point) || !finite(&l.force) {
+            return Err("load has a non-finite number".into());
+        }
+        loads.push((Vec3::from(l.point), Vec3::from(l.force)));
+    }
+    Ok(Block::new(
+        name,
+        material,
+        spec.fixed,
+        vertices,
+        topo,
+        Vec3::from(spec.velocity),
+        Vec3::from(spec.angular_velocity),
+        loads,
+    ))
+}
+
+/// Blocks may touch at the start but not overlap: the separating-axis depth of every nearby
+/// pair must stay below a small tolerance (10⁻⁴ of the model half-size, for coordinates typed
+/// with a few decimals).
+pub(super) fn check_overlaps(blocks: &[Block]) -> Result<(), (usize, String)> {
+    let all: Vec<Vec3> = blocks
+        .iter()
+        .flat_map(|b| b.vertices.iter().copied())
+        .collect();
+    let (lo, hi) = bounding_box(&all);
+    let tol = 1e-4 * 0.5 * (hi - lo).max();
+    let shapes: Vec<Shape> = blocks
+        .iter()
+        .map(|b| Shape {
+            vertices: &b.vertices,
+            topo: &b.topo,
+            face_normals: &b.face_normals,
+            centroid: b.mp.centroid,
+            lo: b.lo,
+            hi: b.hi,
+            fixed: false,
+        })
+        .collect();
+    for (a, b) in broad_phase(&shapes, 0.0) {
+        let depth = overlap_depth(
+            &blocks[a].vertices,
+            &blocks[a].topo,
+            &blocks[b].vertices,
+            &blocks[b].topo,
+        );
+        if depth > tol {
+            return Err((
+                b,
+                format!(
+                    "blocks '{}' and '{}' overlap by {:.3e} m at the start (touching is fine)",
+                    blocks[a].name, blocks[b].name, depth
+                ),
+            ));
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,86 @@
+//! The scene file's TOML format, as serde reads it. Every table denies unknown keys, so a typo is
+//! an error with its line, not a silently ignored setting. The shapes of `[[blocks]]` are built
+//! into blocks by [`super::build`].
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use crate::params::{JointParams, SolverParams};
+use crate::physics::mechanics::Material;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SceneFile {
+    pub(super) name: Option<String>,
+    #[serde(default)]
+    pub(super) solver: SolverParams,
+    #[serde(default)]
+    pub(super) joint: JointParams,
+    #[serde(default)]
+    pub(super) materials: BTreeMap<String, Spanned<Material>>,
+    #[serde(default)]
+    pub(super) blocks: Vec<Spanned<BlockSpec>>,
+}
+
+/// One `[[blocks]]` entry. Exactly one of `vertices`, `box`, `dodecahedron`, `prism`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct BlockSpec {
+    pub(super) name: Option<String>,
+    pub(super) material: String,
+    #[serde(default)]
+    pub(super) fixed: bool,
+    /// Initial centroid velocity, m/s.
+    #[serde(default)]
+    pub(super) velocity: [f64; 3],
+    /// Initial angular velocity, rad/s.
+    #[serde(default)]
+    pub(super) angular_velocity: [f64; 3],
+    pub(super) vertices: Option<Vec<[f64; 3]>>,
+    #[serde(rename = "box")]
+    pub(super) box_: Option<BoxSpec>,
+    pub(super) dodecahedron: Option<DodecahedronSpec>,
+    pub(super) prism: Option<PrismSpec>,
+    /// Point loads moving with the block.
+    #[serde(default)]
+    pub(super) loads: Vec<LoadSpec>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct BoxSpec {
+    /// Edge lengths along the block's own x, y, z, m.
+    pub(super) size: [f64; 3],
+    pub(super) center: [f64; 3],
+    /// Rotation about x, then y, then z (fixed axes), degrees.
+    #[serde(default)]
+    pub(super) rotation: [f64; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct DodecahedronSpec {
+    /// Edge length, m.
+    pub(super) edge: f64,
+    pub(super) center: [f64; 3],
+    #[serde(default)]
+    pub(super) rotation: [f64; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct PrismSpec {
+    /// A convex polygon.
+    pub(super) base: Vec<[f64; 3]>,
+    /// The sweep vector from the base to the top face.
+    pub(super) extrude: [f64; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct LoadSpec {
+    pub(super) point: [f64; 3],
+    pub(super) force: [f64; 3],
+}
