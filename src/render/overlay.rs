@@ -7,7 +7,7 @@ use glam::Vec3;
 
 use super::camera::Camera;
 use super::mesh::{self, LOCK_SRGB, SLIDE_SRGB};
-use super::scene::Scene;
+use super::scene::{FieldLegend, RenderScene};
 
 const TEXT: Color32 = Color32::from_rgb(0x20, 0x20, 0x20);
 const TEXT_DIM: Color32 = Color32::from_rgb(0x44, 0x44, 0x44);
@@ -75,11 +75,31 @@ pub fn format_time(t: f64) -> String {
 
 /// Paints the caption (top left), legends (bottom left) and axis triad (bottom right) into
 /// `rect` (egui points).
-pub fn paint_overlay(painter: &egui::Painter, scene: &Scene, camera: &Camera, rect: Rect) {
-    let transparent = scene.transparent;
+pub fn paint_overlay(painter: &egui::Painter, scene: &RenderScene, camera: &Camera, rect: Rect) {
     let pad = 18.0;
+    paint_caption(painter, scene, rect.min + Vec2::splat(pad));
+    // Legends, stacked upward from the bottom-left corner.
+    let legends = Legends {
+        painter,
+        x: rect.min.x + pad,
+        transparent: scene.transparent,
+        font: FontId::proportional(15.0),
+    };
+    let mut y = rect.max.y - pad;
+    if let Some(f) = &scene.field {
+        y = legends.field(f, y);
+    }
+    if let Some(scale) = scene.force_scale {
+        y = legends.forces(scale, (scene.contacts_lock, scene.contacts_slide), y);
+    }
+    if let Some(step) = scene.grid_step {
+        legends.grid(step, y);
+    }
+    paint_axis_triad(painter, camera, rect);
+}
 
-    // Caption.
+/// Scene name over simulated time and step, on a card at `top_left`.
+fn paint_caption(painter: &egui::Painter, scene: &RenderScene, top_left: Pos2) {
     let title = painter.layout_no_wrap(
         if scene.caption.scene_name.is_empty() {
             "dda3d".to_owned()
@@ -98,7 +118,6 @@ pub fn paint_overlay(painter: &egui::Painter, scene: &Scene, camera: &Camera, re
         FontId::proportional(16.0),
         TEXT_DIM,
     );
-    let top_left = rect.min + Vec2::splat(pad);
     let sub_pos = top_left + Vec2::new(0.0, title.size().y + 3.0);
     let caption_rect = Rect::from_min_size(
         top_left,
@@ -107,15 +126,24 @@ pub fn paint_overlay(painter: &egui::Painter, scene: &Scene, camera: &Camera, re
             title.size().y + 3.0 + sub.size().y,
         ),
     );
-    card(painter, caption_rect, transparent);
+    card(painter, caption_rect, scene.transparent);
     painter.galley(top_left, title, TEXT);
     painter.galley(sub_pos, sub, TEXT_DIM);
+}
 
-    // Legends, stacked upward from the bottom-left corner.
-    let mut y = rect.max.y - pad;
-    let x = rect.min.x + pad;
-    let font = FontId::proportional(15.0);
-    if let Some(f) = &scene.field {
+/// The legend column at the left edge. Each legend is drawn with its bottom at `y` and returns
+/// the `y` for the next one up.
+struct Legends<'a> {
+    painter: &'a egui::Painter,
+    x: f32,
+    transparent: bool,
+    font: FontId,
+}
+
+impl Legends<'_> {
+    /// Colour bar with its quantity, unit and end values.
+    fn field(&self, f: &FieldLegend, y: f32) -> f32 {
+        let (painter, x, font) = (self.painter, self.x, &self.font);
         let bar = Vec2::new(200.0, 12.0);
         let lo = painter.layout_no_wrap(format_value(f.min), font.clone(), TEXT);
         // A frame where every block has the same value (all at rest) has no range to show.
@@ -129,29 +157,10 @@ pub fn paint_overlay(painter: &egui::Painter, scene: &Scene, camera: &Camera, re
         let h = label.size().y + 4.0 + bar.y + 3.0 + lo.size().y;
         let top = y - h;
         let block = Rect::from_min_size(Pos2::new(x, top), Vec2::new(bar.x.max(label.size().x), h));
-        card(painter, block, transparent);
+        card(painter, block, self.transparent);
         painter.galley(Pos2::new(x, top), label.clone(), TEXT);
         let bar_rect = Rect::from_min_size(Pos2::new(x, top + label.size().y + 4.0), bar);
-        let mut m = Mesh::default();
-        const STEPS: usize = 32;
-        for k in 0..=STEPS {
-            let t = k as f32 / STEPS as f32;
-            let c = mesh::linear_to_srgb(mesh::colormap(t));
-            let c = Color32::from_rgb(
-                (c[0] * 255.0).round() as u8,
-                (c[1] * 255.0).round() as u8,
-                (c[2] * 255.0).round() as u8,
-            );
-            let px = bar_rect.min.x + t * bar.x;
-            m.colored_vertex(Pos2::new(px, bar_rect.min.y), c);
-            m.colored_vertex(Pos2::new(px, bar_rect.max.y), c);
-            if k > 0 {
-                let i = (2 * k) as u32;
-                m.add_triangle(i - 2, i - 1, i);
-                m.add_triangle(i - 1, i + 1, i);
-            }
-        }
-        painter.add(egui::Shape::mesh(m));
+        painter.add(egui::Shape::mesh(colormap_bar(bar_rect.min, bar)));
         painter.rect_stroke(
             bar_rect,
             0.0,
@@ -161,24 +170,19 @@ pub fn paint_overlay(painter: &egui::Painter, scene: &Scene, camera: &Camera, re
         let ly = bar_rect.max.y + 3.0;
         painter.galley(Pos2::new(x, ly), lo, TEXT);
         painter.galley(Pos2::new(bar_rect.max.x - hi.size().x, ly), hi, TEXT);
-        y = top - 20.0;
+        top - 20.0
     }
-    if let Some(scale) = scene.force_scale {
+
+    /// Arrow scale, then sample arrows in the lock and slide colours with their counts.
+    fn forces(&self, scale: f64, (locks, slides): (usize, usize), y: f32) -> f32 {
+        let (painter, x, font) = (self.painter, self.x, &self.font);
         let line1 = painter.layout_no_wrap(
             format!("contact force: 1 m of arrow = {}", format_force(scale)),
             font.clone(),
             TEXT,
         );
-        let lock = painter.layout_no_wrap(
-            format!("lock ({})", scene.contacts_lock),
-            font.clone(),
-            TEXT,
-        );
-        let slide = painter.layout_no_wrap(
-            format!("slide ({})", scene.contacts_slide),
-            font.clone(),
-            TEXT,
-        );
+        let lock = painter.layout_no_wrap(format!("lock ({locks})"), font.clone(), TEXT);
+        let slide = painter.layout_no_wrap(format!("slide ({slides})"), font.clone(), TEXT);
         let row = line1.size().y;
         let arrow_w = 34.0;
         let top = y - 2.0 * row - 6.0;
@@ -187,7 +191,7 @@ pub fn paint_overlay(painter: &egui::Painter, scene: &Scene, camera: &Camera, re
         card(
             painter,
             Rect::from_min_size(Pos2::new(x, top), Vec2::new(width, 2.0 * row + 6.0)),
-            transparent,
+            self.transparent,
         );
         let sample_arrow = |at: Pos2, color: Color32| {
             let mid = at.y + row * 0.5;
@@ -197,30 +201,57 @@ pub fn paint_overlay(painter: &egui::Painter, scene: &Scene, camera: &Camera, re
                 Stroke::new(3.0, color),
             );
         };
-        let lock_c = color32(LOCK_SRGB);
-        let slide_c = color32(SLIDE_SRGB);
         sample_arrow(Pos2::new(x, top), TEXT_DIM);
         painter.galley(Pos2::new(x + arrow_w + 8.0, top), line1, TEXT);
         let y2 = top + row + 6.0;
-        sample_arrow(Pos2::new(x, y2), lock_c);
+        sample_arrow(Pos2::new(x, y2), color32(LOCK_SRGB));
         let lock_w = lock.size().x;
         painter.galley(Pos2::new(x + arrow_w + 8.0, y2), lock, TEXT);
         let sx = x + arrow_w + 8.0 + lock_w + 16.0;
-        sample_arrow(Pos2::new(sx, y2), slide_c);
+        sample_arrow(Pos2::new(sx, y2), color32(SLIDE_SRGB));
         painter.galley(Pos2::new(sx + arrow_w + 8.0, y2), slide, TEXT);
-        y = top - 20.0;
+        top - 20.0
     }
-    if let Some(step) = scene.grid_step {
-        painter.text(
-            Pos2::new(x, y),
+
+    /// Grid spacing, as plain text (no card).
+    fn grid(&self, step: f64, y: f32) {
+        self.painter.text(
+            Pos2::new(self.x, y),
             Align2::LEFT_BOTTOM,
             format!("grid {} m", trim_number(step)),
             FontId::proportional(13.0),
             TEXT_DIM,
         );
     }
+}
 
-    // Axis triad: world x, y, z as seen by the camera, nearest axis drawn last.
+/// The colour map from 0 (left) to 1 (right) across a `size` rectangle at `min`, in 32 bands.
+fn colormap_bar(min: Pos2, size: Vec2) -> Mesh {
+    const STEPS: usize = 32;
+    let rect = Rect::from_min_size(min, size);
+    let mut m = Mesh::default();
+    for k in 0..=STEPS {
+        let t = k as f32 / STEPS as f32;
+        let c = mesh::linear_to_srgb(mesh::colormap(t));
+        let c = Color32::from_rgb(
+            (c[0] * 255.0).round() as u8,
+            (c[1] * 255.0).round() as u8,
+            (c[2] * 255.0).round() as u8,
+        );
+        let px = rect.min.x + t * size.x;
+        m.colored_vertex(Pos2::new(px, rect.min.y), c);
+        m.colored_vertex(Pos2::new(px, rect.max.y), c);
+        if k > 0 {
+            let i = (2 * k) as u32;
+            m.add_triangle(i - 2, i - 1, i);
+            m.add_triangle(i - 1, i + 1, i);
+        }
+    }
+    m
+}
+
+/// World x, y, z as the camera sees them, bottom right; the axis nearest the eye is drawn last.
+fn paint_axis_triad(painter: &egui::Painter, camera: &Camera, rect: Rect) {
     let (right, up, back) = camera.basis();
     let centre = Pos2::new(rect.max.x - 62.0, rect.max.y - 62.0);
     let len = 40.0;
@@ -290,7 +321,7 @@ impl Overlay {
         target: &wgpu::TextureView,
         width: u32,
         height: u32,
-        scene: &Scene,
+        scene: &RenderScene,
         camera: &Camera,
     ) {
         let ppp = Self::pixels_per_point(height);

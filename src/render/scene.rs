@@ -9,7 +9,7 @@ use super::mesh::{
     self, Arrow, EDGE_SRGB, LOCK_SRGB, LineInstance, NORMAL_GLYPH_SRGB, OPEN_SRGB, Rgba,
     SLIDE_SRGB, SolidVertex, hex, srgb_to_linear,
 };
-use crate::snapshot::{ContactState, Snapshot};
+use crate::snapshot::{BlockSnapshot, ContactSnapshot, ContactState, Snapshot};
 
 /// What decides a block's colour.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -166,7 +166,7 @@ pub struct FieldLegend {
 
 /// Everything one frame draws, in f32 coordinates relative to `origin`.
 #[derive(Clone, Debug)]
-pub struct Scene {
+pub struct RenderScene {
     pub origin: DVec3,
     /// Block faces (and nothing else) — lit, depth-tested.
     pub solids: Vec<SolidVertex>,
@@ -187,177 +187,47 @@ pub struct Scene {
     pub grid_step: Option<f64>,
 }
 
+/// The old name of [`RenderScene`], kept only until `render/offscreen.rs` and the viewer's
+/// panel are renamed (issue #11).
+pub use self::RenderScene as Scene;
+
 /// Background of opaque frames (sRGB): a light grey that prints well and separates white-ish
 /// blocks from the page.
 pub const BACKGROUND_SRGB: u32 = 0xF4F4F1;
 
-impl Scene {
+impl RenderScene {
     /// Builds the frame. Errors on malformed blocks (face indices out of range, non-finite
     /// vertices); contacts with non-finite data are skipped.
     pub fn build(
         snap: &Snapshot,
         style: &SceneStyle,
         frame: &SceneFrame,
-    ) -> Result<Scene, RenderError> {
+    ) -> Result<RenderScene, RenderError> {
         let origin = frame.origin();
-        let size = frame.size();
+        let field = FieldLegend::for_style(snap, style);
         let mut solids = Vec::new();
-        let mut arrows = Vec::new();
         let mut lines = Vec::new();
-
-        // Colour-map range.
-        let field_value = |b: &crate::snapshot::BlockSnapshot| -> Option<f64> {
-            let v = match style.coloring {
-                Coloring::PerBlock => return None,
-                Coloring::Velocity => DVec3::from_array(b.velocity).length(),
-                Coloring::Displacement => DVec3::from_array(b.displacement).length(),
-            };
-            v.is_finite().then_some(v)
-        };
-        let field = match style.coloring {
-            Coloring::PerBlock => None,
-            c => {
-                let (label, unit) = if c == Coloring::Velocity {
-                    ("speed |v|", "m/s")
-                } else {
-                    ("displacement |u|", "m")
-                };
-                let (min, max) = match style.field_range {
-                    Some((a, b)) if a.is_finite() && b.is_finite() && b > a => (a, b),
-                    _ => {
-                        let max = snap
-                            .blocks
-                            .iter()
-                            .filter(|b| !b.fixed)
-                            .filter_map(field_value)
-                            .fold(0.0, f64::max);
-                        (0.0, max)
-                    }
-                };
-                Some(FieldLegend {
-                    label,
-                    unit,
-                    min,
-                    max,
-                })
-            }
-        };
-
-        let edge = style
-            .edges
-            .then(|| (1.4f32, srgb_to_linear(hex(EDGE_SRGB))));
-        for (i, b) in snap.blocks.iter().enumerate() {
-            let color = match (&field, field_value(b)) {
-                (Some(f), Some(v)) if !b.fixed => {
-                    let t = if f.max > f.min {
-                        (v - f.min) / (f.max - f.min)
-                    } else {
-                        0.0
-                    };
-                    mesh::colormap(t as f32)
-                }
-                _ => mesh::block_color(i, b.fixed),
-            };
-            mesh::push_block(
-                &mut solids,
-                &mut lines,
-                &b.name,
-                &b.vertices,
-                &b.faces,
-                origin,
-                color,
-                edge,
-            )
-            .map_err(|e| RenderError::InvalidSnapshot(e.0))?;
-        }
-
-        // Contacts.
-        let mut contacts_lock = 0;
-        let mut contacts_slide = 0;
-        let usable: Vec<_> = snap
-            .contacts
-            .iter()
-            .filter(|c| {
-                DVec3::from_array(c.point).is_finite()
-                    && DVec3::from_array(c.normal).is_finite()
-                    && DVec3::from_array(c.normal).length() > 1e-12
-                    && c.normal_force.is_finite()
-            })
-            .collect();
-        for c in &usable {
-            match c.state {
-                ContactState::Lock => contacts_lock += 1,
-                ContactState::Slide => contacts_slide += 1,
-                ContactState::Open => {}
-            }
-        }
-        let draw_forces = matches!(style.arrows, ArrowMode::Forces | ArrowMode::Both);
-        let draw_normals = matches!(style.arrows, ArrowMode::Normals | ArrowMode::Both);
-        let max_force = usable
-            .iter()
-            .map(|c| c.normal_force.abs())
-            .fold(0.0, f64::max);
-        let force_scale = if draw_forces && !usable.is_empty() {
-            match style.force_scale {
-                Some(s) if s.is_finite() && s > 0.0 => Some(s),
-                _ => Some(auto_force_scale(max_force, size)),
-            }
-        } else {
-            None
-        };
-        // Arrow thickness follows the scene size, but stays thin next to the blocks when they
-        // are small in a large scene (metre rocks on a kilometre slope).
-        let block = typical_block_size(snap).unwrap_or(size);
-        let shaft = (size * 0.005).min(block * 0.06) as f32;
-        let glyph_len = (size * 0.06).min(block * 0.5) as f32;
-        for c in &usable {
-            let base = (DVec3::from_array(c.point) - origin).as_vec3();
-            let n = DVec3::from_array(c.normal).normalize().as_vec3();
-            let state_color = srgb_to_linear(hex(match c.state {
-                ContactState::Lock => LOCK_SRGB,
-                ContactState::Slide => SLIDE_SRGB,
-                ContactState::Open => OPEN_SRGB,
-            }));
-            if let Some(scale) = force_scale {
-                // The force on block i is +N·n (n points from j toward i); a tensile (negative)
-                // force points the other way.
-                let dir = if c.normal_force >= 0.0 { n } else { -n };
-                // Impacts can carry a hundred times the static forces that set a fixed scale;
-                // cap the arrow at 40 % of the view so it does not cross the whole picture.
-                let len = ((c.normal_force.abs() / scale) as f32).min(0.4 * size as f32);
-                mesh::push_arrow(&mut arrows, &Arrow::new(base, dir, len, shaft), state_color);
-            }
-            if draw_normals {
-                let len = glyph_len;
-                let (r, color) = if draw_forces {
-                    (shaft * 0.45, srgb_to_linear(hex(NORMAL_GLYPH_SRGB)))
-                } else {
-                    (shaft, state_color)
-                };
-                mesh::push_arrow(&mut arrows, &Arrow::new(base, n, len, r), color);
-            }
-        }
-
+        push_blocks(snap, style, field.as_ref(), origin, &mut solids, &mut lines)?;
+        let contacts = ContactArrows::build(snap, style, frame);
         let grid_step = style.grid.then(|| {
             let lo = (frame.lo - origin).as_vec3();
             let hi = (frame.hi - origin).as_vec3();
             mesh::push_grid(&mut lines, lo, hi, origin, 1.0) as f64
         });
-
-        Ok(Scene {
+        Ok(RenderScene {
             origin,
             solids,
-            arrows,
+            arrows: contacts.arrows,
             lines,
             caption: Caption {
                 scene_name: snap.scene_name.clone(),
                 time: snap.time,
                 step: snap.step,
             },
-            force_scale,
+            force_scale: contacts.force_scale,
             field,
-            contacts_lock,
-            contacts_slide,
+            contacts_lock: contacts.lock,
+            contacts_slide: contacts.slide,
             transparent: style.transparent,
             overlay: style.overlay,
             grid_step,
@@ -377,6 +247,205 @@ impl Scene {
     pub fn to_local(&self, world: [f64; 3]) -> Vec3 {
         (DVec3::from_array(world) - self.origin).as_vec3()
     }
+}
+
+/// A block's colour-map value under `coloring` (`None` for per-block colours, or when the
+/// value is not finite).
+fn field_value(b: &BlockSnapshot, coloring: Coloring) -> Option<f64> {
+    let v = match coloring {
+        Coloring::PerBlock => return None,
+        Coloring::Velocity => DVec3::from_array(b.velocity).length(),
+        Coloring::Displacement => DVec3::from_array(b.displacement).length(),
+    };
+    v.is_finite().then_some(v)
+}
+
+/// Largest colour-map value among the moving blocks of a snapshot (0 when there is none).
+pub(super) fn field_max(snap: &Snapshot, coloring: Coloring) -> f64 {
+    snap.blocks
+        .iter()
+        .filter(|b| !b.fixed)
+        .filter_map(|b| field_value(b, coloring))
+        .fold(0.0, f64::max)
+}
+
+impl FieldLegend {
+    /// The legend of `style.coloring` (`None` for per-block colours): the range given, or 0 to
+    /// the largest value in the frame.
+    fn for_style(snap: &Snapshot, style: &SceneStyle) -> Option<FieldLegend> {
+        let (label, unit) = match style.coloring {
+            Coloring::PerBlock => return None,
+            Coloring::Velocity => ("speed |v|", "m/s"),
+            Coloring::Displacement => ("displacement |u|", "m"),
+        };
+        let (min, max) = match style.field_range {
+            Some((a, b)) if a.is_finite() && b.is_finite() && b > a => (a, b),
+            _ => (0.0, field_max(snap, style.coloring)),
+        };
+        Some(FieldLegend {
+            label,
+            unit,
+            min,
+            max,
+        })
+    }
+
+    /// The colour-map colour of `v` (the bottom of the map when the range is empty).
+    fn color(&self, v: f64) -> Rgba {
+        let t = if self.max > self.min {
+            (v - self.min) / (self.max - self.min)
+        } else {
+            0.0
+        };
+        mesh::colormap(t as f32)
+    }
+}
+
+/// Faces and (with `style.edges`) outlines of every block: moving blocks coloured by the field
+/// when there is one, fixed blocks and per-block colouring from the palette.
+fn push_blocks(
+    snap: &Snapshot,
+    style: &SceneStyle,
+    field: Option<&FieldLegend>,
+    origin: DVec3,
+    solids: &mut Vec<SolidVertex>,
+    lines: &mut Vec<LineInstance>,
+) -> Result<(), RenderError> {
+    let edge = style
+        .edges
+        .then(|| (1.4f32, srgb_to_linear(hex(EDGE_SRGB))));
+    for (i, b) in snap.blocks.iter().enumerate() {
+        let color = match (field, field_value(b, style.coloring)) {
+            (Some(f), Some(v)) if !b.fixed => f.color(v),
+            _ => mesh::block_color(i, b.fixed),
+        };
+        mesh::push_block(
+            solids,
+            lines,
+            &b.name,
+            &b.vertices,
+            &b.faces,
+            origin,
+            color,
+            edge,
+        )
+        .map_err(|e| RenderError::InvalidSnapshot(e.0))?;
+    }
+    Ok(())
+}
+
+/// The contact part of a frame: its arrows and what the force legend prints.
+struct ContactArrows {
+    arrows: Vec<SolidVertex>,
+    force_scale: Option<f64>,
+    lock: usize,
+    slide: usize,
+}
+
+/// Radius and length of the glyphs, m.
+#[derive(Clone, Copy)]
+struct GlyphSize {
+    shaft: f32,
+    normal_len: f32,
+}
+
+impl ContactArrows {
+    fn build(snap: &Snapshot, style: &SceneStyle, frame: &SceneFrame) -> ContactArrows {
+        let size = frame.size();
+        let usable: Vec<&ContactSnapshot> = snap
+            .contacts
+            .iter()
+            .filter(|c| {
+                DVec3::from_array(c.point).is_finite()
+                    && DVec3::from_array(c.normal).is_finite()
+                    && DVec3::from_array(c.normal).length() > 1e-12
+                    && c.normal_force.is_finite()
+            })
+            .collect();
+        let count = |s: ContactState| usable.iter().filter(|c| c.state == s).count();
+        let draw_forces = matches!(style.arrows, ArrowMode::Forces | ArrowMode::Both);
+        let draw_normals = matches!(style.arrows, ArrowMode::Normals | ArrowMode::Both);
+        let force_scale = (draw_forces && !usable.is_empty()).then(|| match style.force_scale {
+            Some(s) if s.is_finite() && s > 0.0 => s,
+            _ => {
+                let max_force = usable
+                    .iter()
+                    .map(|c| c.normal_force.abs())
+                    .fold(0.0, f64::max);
+                auto_force_scale(max_force, size)
+            }
+        });
+        // Arrow thickness follows the scene size, but stays thin next to the blocks when they
+        // are small in a large scene (metre rocks on a kilometre slope).
+        let block = typical_block_size(snap).unwrap_or(size);
+        let glyph = GlyphSize {
+            shaft: (size * 0.005).min(block * 0.06) as f32,
+            normal_len: (size * 0.06).min(block * 0.5) as f32,
+        };
+        let mut arrows = Vec::new();
+        for c in &usable {
+            let base = (DVec3::from_array(c.point) - frame.origin()).as_vec3();
+            if let Some(scale) = force_scale {
+                push_force_arrow(&mut arrows, c, base, scale, size, glyph);
+            }
+            if draw_normals {
+                push_normal_glyph(&mut arrows, c, base, draw_forces, glyph);
+            }
+        }
+        ContactArrows {
+            arrows,
+            force_scale,
+            lock: count(ContactState::Lock),
+            slide: count(ContactState::Slide),
+        }
+    }
+}
+
+/// Lock blue, slide red, open grey.
+fn state_color(state: ContactState) -> Rgba {
+    srgb_to_linear(hex(match state {
+        ContactState::Lock => LOCK_SRGB,
+        ContactState::Slide => SLIDE_SRGB,
+        ContactState::Open => OPEN_SRGB,
+    }))
+}
+
+/// The force on block i as an arrow from the contact point, `scale` N per metre.
+fn push_force_arrow(
+    arrows: &mut Vec<SolidVertex>,
+    c: &ContactSnapshot,
+    base: Vec3,
+    scale: f64,
+    scene_size: f64,
+    glyph: GlyphSize,
+) {
+    let n = DVec3::from_array(c.normal).normalize().as_vec3();
+    // The force on block i is +N·n (n points from j toward i); a tensile (negative) force
+    // points the other way.
+    let dir = if c.normal_force >= 0.0 { n } else { -n };
+    // Impacts can carry a hundred times the static forces that set a fixed scale; cap the
+    // arrow at 40 % of the view so it does not cross the whole picture.
+    let len = ((c.normal_force.abs() / scale) as f32).min(0.4 * scene_size as f32);
+    let arrow = Arrow::new(base, dir, len, glyph.shaft);
+    mesh::push_arrow(arrows, &arrow, state_color(c.state));
+}
+
+/// A fixed-length glyph along the contact normal: thin and dark beside force arrows, in the
+/// contact's state colour on its own.
+fn push_normal_glyph(
+    arrows: &mut Vec<SolidVertex>,
+    c: &ContactSnapshot,
+    base: Vec3,
+    beside_forces: bool,
+    glyph: GlyphSize,
+) {
+    let n = DVec3::from_array(c.normal).normalize().as_vec3();
+    let (r, color) = if beside_forces {
+        (glyph.shaft * 0.45, srgb_to_linear(hex(NORMAL_GLYPH_SRGB)))
+    } else {
+        (glyph.shaft, state_color(c.state))
+    };
+    mesh::push_arrow(arrows, &Arrow::new(base, n, glyph.normal_len, r), color);
 }
 
 /// Median bounding-box diagonal of the blocks (None without blocks).
@@ -465,7 +534,7 @@ mod tests {
             ..Default::default()
         };
         let frame = SceneFrame::of_snapshot(&s);
-        let scene = Scene::build(&s, &style, &frame).unwrap();
+        let scene = RenderScene::build(&s, &style, &frame).unwrap();
         assert_eq!(scene.force_scale, Some(2000.0));
         // 1000 N at 2000 N/m → 0.5 m arrow from the contact point along +z.
         let base = scene.to_local([0.0, 0.0, 1.0]);
@@ -477,7 +546,7 @@ mod tests {
         assert!((top - 0.5).abs() < 1e-4, "arrow top {top}");
         // A force far beyond the scale is capped at 40 % of the view.
         let big = snap(vec![contact(1e6, ContactState::Lock)]);
-        let capped = Scene::build(&big, &style, &frame).unwrap();
+        let capped = RenderScene::build(&big, &style, &frame).unwrap();
         let top_big = capped
             .arrows
             .iter()
@@ -499,7 +568,7 @@ mod tests {
             contact(33204.0, ContactState::Lock),
         ]);
         let frame = SceneFrame::of_snapshot(&s);
-        let scene = Scene::build(&s, &SceneStyle::default(), &frame).unwrap();
+        let scene = RenderScene::build(&s, &SceneStyle::default(), &frame).unwrap();
         let scale = scene.force_scale.unwrap();
         let longest = 60154.0 / scale;
         assert!(longest <= 0.20 * frame.size() + 1e-9 && longest > 0.08 * frame.size());
@@ -511,7 +580,8 @@ mod tests {
     #[test]
     fn no_contacts_no_arrows_and_grid_present() {
         let s = snap(vec![]);
-        let scene = Scene::build(&s, &SceneStyle::default(), &SceneFrame::of_snapshot(&s)).unwrap();
+        let scene =
+            RenderScene::build(&s, &SceneStyle::default(), &SceneFrame::of_snapshot(&s)).unwrap();
         assert!(scene.arrows.is_empty());
         assert!(scene.force_scale.is_none());
         assert!(scene.grid_step.is_some());
@@ -527,7 +597,7 @@ mod tests {
             coloring: Coloring::Velocity,
             ..Default::default()
         };
-        let scene = Scene::build(&s, &style, &SceneFrame::of_snapshot(&s)).unwrap();
+        let scene = RenderScene::build(&s, &style, &SceneFrame::of_snapshot(&s)).unwrap();
         let f = scene.field.clone().unwrap();
         assert_eq!((f.min, f.max), (0.0, 2.0));
         // Fixed block keeps the stone grey, the moving one takes the top of the map.
@@ -539,10 +609,10 @@ mod tests {
     fn bad_input_is_an_error_or_skipped() {
         let mut s = snap(vec![contact(f64::NAN, ContactState::Lock)]);
         let frame = SceneFrame::of_snapshot(&s);
-        let scene = Scene::build(&s, &SceneStyle::default(), &frame).unwrap();
+        let scene = RenderScene::build(&s, &SceneStyle::default(), &frame).unwrap();
         assert!(scene.arrows.is_empty());
         s.blocks[1].faces[0][0] = 42;
-        let err = Scene::build(&s, &SceneStyle::default(), &frame).unwrap_err();
+        let err = RenderScene::build(&s, &SceneStyle::default(), &frame).unwrap_err();
         assert!(err.to_string().contains("top"), "{err}");
         assert!(matches!(err, RenderError::InvalidSnapshot(_)));
     }
@@ -553,7 +623,7 @@ mod tests {
         s.blocks.clear();
         let f = SceneFrame::of_snapshot(&s);
         assert!(f.size() > 1.0);
-        assert!(Scene::build(&s, &SceneStyle::default(), &f).is_ok());
+        assert!(RenderScene::build(&s, &SceneStyle::default(), &f).is_ok());
     }
 
     #[test]
@@ -567,7 +637,7 @@ mod tests {
         s.blocks.push(cube("c2", [5.0, 0.0, 1.0], false));
         s.blocks.push(cube("c3", [7.0, 0.0, 1.0], false));
         let frame = SceneFrame::of_snapshot(&s);
-        let scene = Scene::build(&s, &SceneStyle::default(), &frame).unwrap();
+        let scene = RenderScene::build(&s, &SceneStyle::default(), &frame).unwrap();
         let base = scene.to_local([0.0, 0.0, 1.0]);
         let radius = scene
             .arrows

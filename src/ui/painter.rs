@@ -7,40 +7,38 @@
 //! negligible. The headless overlay (`render::overlay`) keeps egui-wgpu; it paints a few labels.
 //!
 //! Same conventions as egui-wgpu: textures and vertex colours are sRGB-encoded, premultiplied
-//! alpha, blended in gamma space into a non-sRGB target.
+//! alpha, blended in gamma space into a non-sRGB target. The shader is `shaders/egui.wgsl`; the
+//! pipeline is declared with the renderer's set-up helpers (`render::pipeline`).
 
 use std::collections::HashMap;
 
 use egui::epaint::{self, ImageData, Primitive, TextureId, textures::TextureFilter};
-use wgpu::util::DeviceExt;
 
-const SHADER: &str = r#"
-struct Locals { screen_size: vec2<f32>, _pad: vec2<f32> };
-@group(0) @binding(0) var<uniform> locals: Locals;
-@group(1) @binding(0) var tex: texture_2d<f32>;
-@group(1) @binding(1) var samp: sampler;
-
-struct VOut {
-    @builtin(position) pos: vec4<f32>,
-    @location(0) uv: vec2<f32>,
-    @location(1) color: vec4<f32>,
+use crate::render::buffer::GrowBuffer;
+use crate::render::pipeline::{
+    ColorTarget, PipelineSpec, Uniform, bind_group_layout, pipeline_layout, sampler_entry,
+    shader_module, texture_entry,
 };
 
-@vertex
-fn vs(@location(0) p: vec2<f32>, @location(1) uv: vec2<f32>, @location(2) c: u32) -> VOut {
-    var out: VOut;
-    out.pos = vec4<f32>(2.0 * p.x / locals.screen_size.x - 1.0,
-                        1.0 - 2.0 * p.y / locals.screen_size.y, 0.0, 1.0);
-    out.uv = uv;
-    out.color = unpack4x8unorm(c);
-    return out;
-}
+/// Smallest mesh buffer allocated, bytes: a typical frame's meshes fit from the start.
+const MIN_MESH_BYTES: u64 = 1 << 16;
 
-@fragment
-fn fs(in: VOut) -> @location(0) vec4<f32> {
-    return in.color * textureSample(tex, samp, in.uv);
-}
-"#;
+const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2, 2 => Uint32];
+
+/// Premultiplied alpha, as egui-wgpu.
+const BLEND: wgpu::BlendState = wgpu::BlendState {
+    color: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
+        operation: wgpu::BlendOperation::Add,
+    },
+    alpha: wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    },
+};
 
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -74,13 +72,13 @@ pub struct Screen {
 
 pub struct EguiPainter {
     pipeline: wgpu::RenderPipeline,
-    locals: wgpu::Buffer,
-    locals_bind_group: wgpu::BindGroup,
+    /// Screen size in points (x, y; the rest is padding).
+    locals: Uniform<[f32; 4]>,
     texture_layout: wgpu::BindGroupLayout,
     textures: HashMap<TextureId, Texture>,
     samplers: HashMap<epaint::textures::TextureOptions, wgpu::Sampler>,
-    vertices: Option<wgpu::Buffer>,
-    indices: Option<wgpu::Buffer>,
+    vertices: GrowBuffer<GpuVertex>,
+    indices: GrowBuffer<u32>,
     draws: Vec<Draw>,
     next_user_id: u64,
 }
@@ -88,117 +86,55 @@ pub struct EguiPainter {
 impl EguiPainter {
     /// A painter for targets of `format` (non-sRGB: egui blends in gamma space).
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> EguiPainter {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("dda3d egui"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
-        });
-        let locals = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("dda3d egui locals"),
-            contents: bytemuck::cast_slice(&[0f32; 4]),
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        });
-        let locals_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("dda3d egui locals"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
-        });
-        let locals_bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("dda3d egui locals"),
-            layout: &locals_layout,
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: locals.as_entire_binding(),
-            }],
-        });
-        let texture_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("dda3d egui texture"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Texture {
-                        sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                        view_dimension: wgpu::TextureViewDimension::D2,
-                        multisampled: false,
-                    },
-                    count: None,
-                },
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("dda3d egui"),
-            bind_group_layouts: &[Some(&locals_layout), Some(&texture_layout)],
-            immediate_size: 0,
-        });
-        let attrs = wgpu::vertex_attr_array![0 => Float32x2, 1 => Float32x2, 2 => Uint32];
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("dda3d egui"),
-            layout: Some(&layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<GpuVertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &attrs,
-                })],
+        let locals = Uniform::new(
+            device,
+            "dda3d egui locals",
+            &[0f32; 4],
+            wgpu::ShaderStages::VERTEX,
+        );
+        let texture_layout = bind_group_layout(
+            device,
+            "dda3d egui texture",
+            &[texture_entry(0), sampler_entry(1)],
+        );
+        let layout = pipeline_layout(device, "dda3d egui", &[locals.layout(), &texture_layout]);
+        let module = shader_module(
+            device,
+            "dda3d egui.wgsl",
+            include_str!("../../shaders/egui.wgsl"),
+        );
+        let pipeline = PipelineSpec {
+            label: "dda3d egui",
+            layout: &layout,
+            module: &module,
+            vertex_entry: "vs",
+            fragment_entry: "fs",
+            vertex_buffer: wgpu::VertexBufferLayout {
+                array_stride: std::mem::size_of::<GpuVertex>() as u64,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &VERTEX_ATTRIBUTES,
             },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: None,
-            multisample: wgpu::MultisampleState::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState {
-                    format,
-                    // Premultiplied alpha, as egui-wgpu.
-                    blend: Some(wgpu::BlendState {
-                        color: wgpu::BlendComponent {
-                            src_factor: wgpu::BlendFactor::One,
-                            dst_factor: wgpu::BlendFactor::OneMinusSrcAlpha,
-                            operation: wgpu::BlendOperation::Add,
-                        },
-                        alpha: wgpu::BlendComponent {
-                            src_factor: wgpu::BlendFactor::OneMinusDstAlpha,
-                            dst_factor: wgpu::BlendFactor::One,
-                            operation: wgpu::BlendOperation::Add,
-                        },
-                    }),
-                    write_mask: wgpu::ColorWrites::ALL,
-                })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+            target: ColorTarget { format, samples: 1 },
+            blend: Some(BLEND),
+            depth: None,
+        }
+        .build(device);
         EguiPainter {
             pipeline,
             locals,
-            locals_bind_group,
             texture_layout,
             textures: HashMap::new(),
             samplers: HashMap::new(),
-            vertices: None,
-            indices: None,
+            vertices: GrowBuffer::new(
+                "dda3d egui vertices",
+                wgpu::BufferUsages::VERTEX,
+                MIN_MESH_BYTES,
+            ),
+            indices: GrowBuffer::new(
+                "dda3d egui indices",
+                wgpu::BufferUsages::INDEX,
+                MIN_MESH_BYTES,
+            ),
             draws: Vec::new(),
             next_user_id: 0,
         }
@@ -403,11 +339,8 @@ impl EguiPainter {
     ) {
         let ppp = screen.pixels_per_point;
         let [sw, sh] = screen.size_in_pixels;
-        queue.write_buffer(
-            &self.locals,
-            0,
-            bytemuck::cast_slice(&[sw as f32 / ppp, sh as f32 / ppp, 0.0, 0.0]),
-        );
+        self.locals
+            .write(queue, &[sw as f32 / ppp, sh as f32 / ppp, 0.0, 0.0]);
         self.draws.clear();
         let mut vertices: Vec<GpuVertex> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
@@ -441,34 +374,22 @@ impl EguiPainter {
                 scissor: [x0, y0, x1 - x0, y1 - y0],
             });
         }
-        upload(
-            device,
-            queue,
-            &mut self.vertices,
-            bytemuck::cast_slice(&vertices),
-            wgpu::BufferUsages::VERTEX,
-        );
-        upload(
-            device,
-            queue,
-            &mut self.indices,
-            bytemuck::cast_slice(&indices),
-            wgpu::BufferUsages::INDEX,
-        );
+        self.vertices.upload(device, queue, &vertices);
+        self.indices.upload(device, queue, &indices);
     }
 
     /// Records the prepared meshes into `pass` (a target of the prepared size).
     pub fn render(&self, pass: &mut wgpu::RenderPass<'_>) {
-        let (Some(vb), Some(ib)) = (&self.vertices, &self.indices) else {
+        let (Some(vb), Some(ib)) = (self.vertices.slice(), self.indices.slice()) else {
             return;
         };
         if self.draws.is_empty() {
             return;
         }
         pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, &self.locals_bind_group, &[]);
-        pass.set_vertex_buffer(0, vb.slice(..));
-        pass.set_index_buffer(ib.slice(..), wgpu::IndexFormat::Uint32);
+        pass.set_bind_group(0, self.locals.bind_group(), &[]);
+        pass.set_vertex_buffer(0, vb);
+        pass.set_index_buffer(ib, wgpu::IndexFormat::Uint32);
         for d in &self.draws {
             let Some(t) = self.textures.get(&d.texture) else {
                 continue;
@@ -478,31 +399,5 @@ impl EguiPainter {
             pass.set_bind_group(1, &t.bind_group, &[]);
             pass.draw_indexed(d.indices.clone(), d.base_vertex, 0..1);
         }
-    }
-}
-
-/// Writes `data` into `slot`, growing the buffer (to the next power of two) when needed.
-fn upload(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    slot: &mut Option<wgpu::Buffer>,
-    data: &[u8],
-    usage: wgpu::BufferUsages,
-) {
-    if data.is_empty() {
-        return;
-    }
-    // Copies must be multiples of 4 bytes; vertices (20 B) and u32 indices always are.
-    let need = data.len() as u64;
-    if slot.as_ref().is_none_or(|b| b.size() < need) {
-        *slot = Some(device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("dda3d egui mesh"),
-            size: need.next_power_of_two().max(1 << 16),
-            usage: usage | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        }));
-    }
-    if let Some(b) = slot {
-        queue.write_buffer(b, 0, data);
     }
 }
