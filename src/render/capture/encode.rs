@@ -1,5 +1,5 @@
-//! Pixels to files: PNG frames (one encoder thread each, [`encode_loop`]) and the animated GIF
-//! ([`gif_loop`]), with the alpha handling both need, since the GPU reads back premultiplied
+//! Pixels to files: PNG frames (on the encoder threads, [`encode_loop`]) and the animated GIF
+//! (on its own thread, [`gif_loop`]), with the alpha handling both need, since the GPU reads back premultiplied
 //! alpha and GIF has only on/off transparency.
 
 use std::fs::File;

@@ -4,6 +4,7 @@
 
 use std::path::Path;
 
+use super::encode::write_png;
 use super::options::{CaptureOptions, Framing};
 use crate::render::RenderError;
 use crate::render::camera::Camera;
@@ -11,8 +12,6 @@ use crate::render::gpu::Gpu;
 use crate::render::offscreen::Offscreen;
 use crate::render::scene::{self, Coloring, RenderScene, SceneFrame, SceneStyle};
 use crate::snapshot::Snapshot;
-
-use super::encode::write_png;
 
 /// Keeps camera, grid, force scale and colour range fixed across frames (unless framing is
 /// per frame), so a sequence compares frame to frame.

@@ -12,8 +12,8 @@
 //! and PNG encoding runs beside it, so a long capture costs max(solver, render, encode) per
 //! frame rather than their sum.
 //!
-//! This room holds the threads and their hand-offs; [`options`] what a capture is asked for,
-//! [`frames`] the look that stays fixed across a sequence (and single screenshots), [`encode`]
+//! This room holds the threads and their hand-offs; `options` what a capture is asked for,
+//! `frames` the look that stays fixed across a sequence (and single screenshots), `encode`
 //! the PNG and GIF writers.
 
 mod encode;
