@@ -57,7 +57,7 @@ pub struct Frame {
     /// Publication counter (increases by one per frame).
     pub seq: u64,
     /// Number of commands applied before this frame was published: a frame reflects command
-    /// `id` (as returned by [`SimHandle::send`]) when `applied >= id`.
+    /// `id` (as returned by [`SimHandle::send`](super::SimHandle::send)) when `applied >= id`.
     pub applied: u64,
     /// Increases on every reset, so the window can clear plots of the previous run.
     pub generation: u64,
