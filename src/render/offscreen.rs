@@ -2,6 +2,9 @@
 //! mappable buffer whose rows are padded to wgpu's `COPY_BYTES_PER_ROW_ALIGNMENT` (256 bytes),
 //! then strips the padding. Two readback buffers let the next frame be drawn while the previous
 //! one is being read ([`Offscreen::submit`] / [`Offscreen::read`]).
+//!
+//! The copy, mapping and unpadding live in one place, [`Readback`], which the viewer's
+//! whole-window screenshot uses too (for a surface that may store its bytes as BGRA).
 
 use std::sync::mpsc;
 
@@ -11,14 +14,14 @@ use super::scene::Scene;
 use super::{Gpu, OFFSCREEN_FORMAT, RenderError, RenderTargets, Renderer};
 
 /// Bytes per row of the readback buffer: `width * 4` rounded up to the copy alignment.
-pub fn padded_bytes_per_row(width: u32) -> u32 {
+fn padded_bytes_per_row(width: u32) -> u32 {
     let unpadded = width * 4;
     let align = wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
     unpadded.div_ceil(align) * align
 }
 
 /// Copies `height` rows of `width * 4` bytes out of a buffer with `padded` bytes per row.
-pub fn strip_row_padding(padded_data: &[u8], width: u32, height: u32, padded: u32) -> Vec<u8> {
+fn strip_row_padding(padded_data: &[u8], width: u32, height: u32, padded: u32) -> Vec<u8> {
     let row = (width * 4) as usize;
     let mut out = Vec::with_capacity(row * height as usize);
     for chunk in padded_data.chunks(padded as usize).take(height as usize) {
@@ -27,8 +30,142 @@ pub fn strip_row_padding(padded_data: &[u8], width: u32, height: u32, padded: u3
     out
 }
 
-struct Slot {
+/// The byte order of a texture with four 8-bit channels.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChannelOrder {
+    Rgba,
+    /// Blue first, as window surfaces often are.
+    Bgra,
+}
+
+impl ChannelOrder {
+    /// The order of `format`, or `None` for a format that is not 8-bit RGBA or BGRA.
+    pub fn of(format: wgpu::TextureFormat) -> Option<ChannelOrder> {
+        match format {
+            wgpu::TextureFormat::Rgba8Unorm | wgpu::TextureFormat::Rgba8UnormSrgb => {
+                Some(ChannelOrder::Rgba)
+            }
+            wgpu::TextureFormat::Bgra8Unorm | wgpu::TextureFormat::Bgra8UnormSrgb => {
+                Some(ChannelOrder::Bgra)
+            }
+            _ => None,
+        }
+    }
+}
+
+/// A mappable buffer that receives the copy of a whole `width`×`height` single-sample texture
+/// and gives it back as RGBA bytes, top row first.
+pub struct Readback {
     buffer: wgpu::Buffer,
+    padded_row: u32,
+    width: u32,
+    height: u32,
+    order: ChannelOrder,
+}
+
+/// The mapping of a [`Readback`] requested after its copy was submitted.
+pub struct Mapping(mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>);
+
+impl Readback {
+    /// Bytes the buffer needs for a `width`×`height` texture (for checking the GPU's limit).
+    pub fn buffer_size(width: u32, height: u32) -> u64 {
+        padded_bytes_per_row(width) as u64 * height as u64
+    }
+
+    pub fn new(
+        device: &wgpu::Device,
+        label: &str,
+        order: ChannelOrder,
+        width: u32,
+        height: u32,
+    ) -> Readback {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size: Readback::buffer_size(width, height),
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        Readback {
+            buffer,
+            padded_row: padded_bytes_per_row(width),
+            width,
+            height,
+            order,
+        }
+    }
+
+    /// Records the copy of `texture` (of this readback's size) into the buffer.
+    pub fn copy_from(&self, encoder: &mut wgpu::CommandEncoder, texture: &wgpu::Texture) {
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &self.buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(self.padded_row),
+                    rows_per_image: Some(self.height),
+                },
+            },
+            wgpu::Extent3d {
+                width: self.width,
+                height: self.height,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+
+    /// Requests the buffer's mapping; call once the copy has been submitted.
+    pub fn map(&self) -> Mapping {
+        let (tx, rx) = mpsc::channel();
+        self.buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+            let _ = tx.send(r);
+        });
+        Mapping(rx)
+    }
+
+    /// Waits for `submission` (`None`: all submitted work) and the mapping, and returns
+    /// `width * height * 4` bytes of RGBA, top row first.
+    pub fn read(
+        &self,
+        device: &wgpu::Device,
+        mapping: Mapping,
+        submission: Option<wgpu::SubmissionIndex>,
+    ) -> Result<Vec<u8>, RenderError> {
+        device
+            .poll(wgpu::PollType::Wait {
+                submission_index: submission,
+                timeout: None,
+            })
+            .map_err(|e| RenderError::Gpu(e.to_string()))?;
+        mapping
+            .0
+            .recv()
+            .map_err(|_| RenderError::Gpu("readback callback never ran".into()))?
+            .map_err(|e| RenderError::Gpu(format!("readback failed: {e}")))?;
+        let mut pixels = {
+            let view = self
+                .buffer
+                .get_mapped_range(..)
+                .map_err(|e| RenderError::Gpu(format!("readback mapping: {e}")))?;
+            strip_row_padding(&view, self.width, self.height, self.padded_row)
+        };
+        self.buffer.unmap();
+        if self.order == ChannelOrder::Bgra {
+            for p in pixels.chunks_exact_mut(4) {
+                p.swap(0, 2);
+            }
+        }
+        Ok(pixels)
+    }
+}
+
+struct Slot {
+    readback: Readback,
     busy: bool,
 }
 
@@ -36,7 +173,7 @@ struct Slot {
 pub struct Pending {
     slot: usize,
     submission: wgpu::SubmissionIndex,
-    mapped: mpsc::Receiver<Result<(), wgpu::BufferAsyncError>>,
+    mapped: Mapping,
 }
 
 /// An off-screen render target of fixed size with its own renderer and overlay.
@@ -49,7 +186,6 @@ pub struct Offscreen {
     targets: RenderTargets,
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
-    padded_row: u32,
     slots: Vec<Slot>,
 }
 
@@ -94,8 +230,7 @@ impl Offscreen {
                 "image size {width}x{height} is outside 1..={max} pixels per side on this GPU"
             )));
         }
-        let padded_row = padded_bytes_per_row(width);
-        let buffer_size = padded_row as u64 * height as u64;
+        let buffer_size = Readback::buffer_size(width, height);
         if buffer_size > limits.max_buffer_size {
             return Err(RenderError::InvalidOptions(format!(
                 "image size {width}x{height} needs a {buffer_size}-byte readback buffer; \
@@ -110,12 +245,13 @@ impl Offscreen {
         let output_view = output.create_view(&Default::default());
         let slots = (0..2)
             .map(|_| Slot {
-                buffer: gpu.device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("dda3d readback"),
-                    size: buffer_size,
-                    usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                    mapped_at_creation: false,
-                }),
+                readback: Readback::new(
+                    &gpu.device,
+                    "dda3d readback",
+                    ChannelOrder::Rgba,
+                    width,
+                    height,
+                ),
                 busy: false,
             })
             .collect();
@@ -129,7 +265,6 @@ impl Offscreen {
             targets,
             output,
             output_view,
-            padded_row,
             slots,
         })
     }
@@ -179,53 +314,26 @@ impl Offscreen {
                 camera,
             );
         }
-        let buffer = &self.slots[slot].buffer;
-        copy_to_readback(
-            &mut encoder,
-            &self.output,
-            buffer,
-            self.padded_row,
-            self.width,
-            self.height,
-        );
+        let readback = &self.slots[slot].readback;
+        readback.copy_from(&mut encoder, &self.output);
         let submission = queue.submit([encoder.finish()]);
-        let (tx, rx) = mpsc::channel();
-        buffer.map_async(wgpu::MapMode::Read, .., move |r| {
-            let _ = tx.send(r);
-        });
+        let mapped = readback.map();
         self.slots[slot].busy = true;
         self.gpu.take_error()?;
         Ok(Pending {
             slot,
             submission,
-            mapped: rx,
+            mapped,
         })
     }
 
     /// Waits for a submitted frame and returns its pixels: `width * height * 4` bytes of RGBA
     /// (sRGB; premultiplied alpha when the background is transparent), top row first.
     pub fn read(&mut self, pending: Pending) -> Result<Vec<u8>, RenderError> {
-        self.gpu
-            .device
-            .poll(wgpu::PollType::Wait {
-                submission_index: Some(pending.submission),
-                timeout: None,
-            })
-            .map_err(|e| RenderError::Gpu(e.to_string()))?;
-        let mapped = pending
-            .mapped
-            .recv()
-            .map_err(|_| RenderError::Gpu("readback callback never ran".into()))?;
-        mapped.map_err(|e| RenderError::Gpu(format!("readback failed: {e}")))?;
         let slot = &mut self.slots[pending.slot];
-        let pixels = {
-            let view = slot
-                .buffer
-                .get_mapped_range(..)
-                .map_err(|e| RenderError::Gpu(format!("readback mapping: {e}")))?;
-            strip_row_padding(&view, self.width, self.height, self.padded_row)
-        };
-        slot.buffer.unmap();
+        let pixels =
+            slot.readback
+                .read(&self.gpu.device, pending.mapped, Some(pending.submission))?;
         slot.busy = false;
         self.gpu.take_error()?;
         Ok(pixels)
@@ -261,39 +369,6 @@ pub fn readable_target(
         usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
         view_formats: &[],
     })
-}
-
-/// Records the copy of a whole single-sample texture into a readback buffer whose rows are
-/// `padded_row` bytes apart (wgpu's 256-byte row alignment).
-pub fn copy_to_readback(
-    encoder: &mut wgpu::CommandEncoder,
-    texture: &wgpu::Texture,
-    buffer: &wgpu::Buffer,
-    padded_row: u32,
-    width: u32,
-    height: u32,
-) {
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo {
-            texture,
-            mip_level: 0,
-            origin: wgpu::Origin3d::ZERO,
-            aspect: wgpu::TextureAspect::All,
-        },
-        wgpu::TexelCopyBufferInfo {
-            buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded_row),
-                rows_per_image: Some(height),
-            },
-        },
-        wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-    );
 }
 
 #[cfg(test)]

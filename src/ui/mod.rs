@@ -3,10 +3,14 @@
 //! - [`sim`]: the simulation thread and its command/frame protocol;
 //! - [`view`]: camera controls and picking (pure logic);
 //! - [`panel`]: the egui panels (toolbar, parameters, display, selection, plots);
-//! - [`app`]: the winit window, the wgpu surface and the frame loop;
+//! - `app/`: the winit application and the frame loop, with its parts: the window and its
+//!   surface, the 3-D view's texture, screenshots and recordings, and frame pacing;
 //! - [`painter`]: draws egui's meshes with wgpu (fast on software rasterizers).
+//!
+//! The viewer knows nothing of the command line: it takes [`ViewerOptions`] and reports
+//! [`ViewerError`]; `crate::cli` reads the flags and maps the error to an exit status.
 
-pub mod app;
+mod app;
 pub mod painter;
 pub mod panel;
 pub mod sim;
@@ -14,132 +18,37 @@ pub mod view;
 
 use std::path::PathBuf;
 
-use clap::Args;
-
-use crate::cli::{CliError, SolverOverrides, load_scene};
-use crate::output::slug;
+use crate::render::RenderError;
+use crate::scene::Scene;
 use sim::Speed;
 
-#[derive(Args, Debug, Clone)]
-pub struct ViewArgs {
-    /// Scene file (TOML).
-    pub scene: PathBuf,
-    #[command(flatten)]
-    pub overrides: SolverOverrides,
-    /// Initial window size in pixels, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+pub use app::run_viewer;
+
+/// What the viewer is to show, and how.
+pub struct ViewerOptions {
+    pub scene: Scene,
+    /// Initial window size in pixels.
     pub size: (u32, u32),
-    /// Simulation speed: a real-time factor (1 = real time, 0.1 = slow motion) or `max`.
-    #[arg(long, default_value = "1", value_parser = parse_speed)]
     pub speed: Speed,
-    /// Open paused at t = 0 instead of running.
-    #[arg(long)]
-    pub paused: bool,
-    /// Write the whole window (3-D view and panels) to this PNG, then exit (after
-    /// --exit-after-frames frames, default 10).
-    #[arg(long)]
+    /// Start running (false: paused at t = 0).
+    pub play: bool,
+    /// Write the whole window to this PNG on the last frame (with `exit_after_frames`).
     pub screenshot: Option<PathBuf>,
-    /// Render this many frames, then exit with status 0 (with --screenshot: write it first).
-    /// Prints the frame time and solver speed on exit.
-    #[arg(long)]
+    /// Draw this many frames, print the frame-time report and close.
     pub exit_after_frames: Option<u64>,
-    /// MSAA samples of the 3-D view (1 or 4). Default: 4 on a GPU, 1 on a software
-    /// rasterizer, where 4× costs about three times as much per frame.
-    #[arg(long)]
+    /// MSAA samples of the 3-D view (None: 4 on a GPU, 1 on a software rasterizer).
     pub msaa: Option<u32>,
-    /// Directory for the screenshot button and recordings (default: out/<scene name>).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
+    /// Directory for the screenshot button and recordings.
+    pub out_dir: PathBuf,
 }
 
-/// Frames rendered before `--screenshot` is taken when `--exit-after-frames` is not given:
-/// enough for egui to settle its layout.
-const DEFAULT_SCREENSHOT_FRAMES: u64 = 10;
-
-fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
-    let num = |t: &str| {
-        t.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|v| (64..=16384).contains(v))
-            .ok_or_else(|| format!("window size {s:?}: each side must be 64..=16384 pixels"))
-    };
-    Ok((num(w)?, num(h)?))
-}
-
-fn parse_speed(s: &str) -> Result<Speed, String> {
-    let t = s.trim().to_ascii_lowercase();
-    if t == "max" || t == "fast" {
-        return Ok(Speed::Max);
-    }
-    let t = t.trim_end_matches(['x', '×']);
-    match t.parse::<f64>() {
-        Ok(f) if f.is_finite() && f > 0.0 && f <= 1e6 => Ok(Speed::RealTime(f)),
-        _ => Err(format!(
-            "--speed expects a positive real-time factor (e.g. 1, 0.25) or `max`, got {s:?}"
-        )),
-    }
-}
-
-/// `dda3d view`.
-pub fn run_viewer(args: &ViewArgs) -> Result<(), CliError> {
-    let scene = load_scene(&args.scene, &args.overrides)?;
-    if let Some(n) = args.msaa
-        && !matches!(n, 1 | 4)
-    {
-        return Err(CliError::Input(format!("--msaa must be 1 or 4, got {n}")));
-    }
-    if args.exit_after_frames == Some(0) {
-        return Err(CliError::Input(
-            "--exit-after-frames must be at least 1".into(),
-        ));
-    }
-    if let Some(p) = &args.screenshot
-        && let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty())
-        && !dir.is_dir()
-    {
-        return Err(CliError::Input(format!(
-            "--screenshot {}: directory {} does not exist",
-            p.display(),
-            dir.display()
-        )));
-    }
-    let out_dir = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)));
-    let exit_after = args
-        .exit_after_frames
-        .or(args.screenshot.as_ref().map(|_| DEFAULT_SCREENSHOT_FRAMES));
-    app::run(app::Options {
-        scene,
-        size: args.size,
-        speed: args.speed,
-        play: !args.paused,
-        screenshot: args.screenshot.clone(),
-        exit_after_frames: exit_after,
-        msaa: args.msaa,
-        out_dir,
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sizes_and_speeds_parse() {
-        assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
-        assert_eq!(parse_size("800X600"), Ok((800, 600)));
-        assert!(parse_size("1280").is_err());
-        assert!(parse_size("0x720").is_err());
-        assert_eq!(parse_speed("max"), Ok(Speed::Max));
-        assert_eq!(parse_speed("0.25"), Ok(Speed::RealTime(0.25)));
-        assert_eq!(parse_speed("2x"), Ok(Speed::RealTime(2.0)));
-        assert!(parse_speed("-1").is_err());
-        assert!(parse_speed("fastest").is_err());
-    }
+/// Why the viewer could not run or stopped, as one line.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewerError {
+    /// No GPU adapter at all: a driver is missing (the message says which to install).
+    #[error("{}", RenderError::NoAdapter)]
+    NoAdapter,
+    /// The window, the GPU, the simulation thread or the `--screenshot` file failed.
+    #[error("{0}")]
+    Failed(String),
 }

@@ -1,0 +1,167 @@
+//! The `dda3d` binary's front end: parses the command line, checks the options, loads the scene
+//! and hands over to the library, then turns any failure into one line on stderr and an exit
+//! status (2 for bad input, 1 for a run that failed).
+//!
+//! One file per subcommand, each with its clap arguments and its entry function:
+//! [`run`](run()) (headless simulation), [`render`](render()) (PNG frames), [`generate`](generate())
+//! (scene files), [`bench`](bench()) and [`view`](view()) (the interactive viewer). The command
+//! line is a contract: flags, defaults, help texts and exit statuses stay as they are.
+
+mod bench;
+mod generate;
+mod render;
+mod run;
+mod view;
+
+use std::ffi::OsString;
+use std::path::Path;
+use std::process::ExitCode;
+
+use clap::{Args, Parser};
+
+use crate::params::{Method, Mode};
+use crate::scene::{self, Scene, SceneError};
+
+pub use bench::{BenchArgs, bench};
+pub use generate::{GenerateArgs, GeneratedKind, generate};
+pub use render::{RenderArgs, render};
+pub use run::{Progress, RunArgs, run};
+pub use view::{ViewArgs, view};
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "dda3d",
+    version,
+    about = "3-D Discontinuous Deformation Analysis of jointed rock (DDA-3a)"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: CliCommand,
+}
+
+#[derive(clap::Subcommand, Debug)]
+pub enum CliCommand {
+    /// Simulate a scene without any window or GPU; write blocks.csv, contacts.csv, summary.json.
+    Run(RunArgs),
+    /// Simulate headless and write PNG frames (and optionally an animated GIF) for reports.
+    Render(RenderArgs),
+    /// Write a generated scene file (for measuring cost as the model grows).
+    Generate(GenerateArgs),
+    /// Time the rockfall scene with both methods, and the scaling on generated walls.
+    Bench(BenchArgs),
+    /// Open the interactive viewer (`dda3d SCENE.toml` is short for `dda3d view SCENE.toml`).
+    View(ViewArgs),
+}
+
+/// Overrides of the scene's `[solver]` table, shared by the commands that simulate.
+#[derive(Args, Debug, Clone, Default)]
+pub struct SolverOverrides {
+    /// Contact method: alm (DDA-3a) or penalty (DDA-3p).
+    #[arg(long, value_enum)]
+    pub method: Option<Method>,
+    /// Time integration: dynamic or static.
+    #[arg(long, value_enum)]
+    pub mode: Option<Mode>,
+    /// Simulated time, s.
+    #[arg(long)]
+    pub duration: Option<f64>,
+}
+
+/// How a command failed, and with which exit status.
+#[derive(Debug)]
+pub enum CliError {
+    /// Bad input: exit status 2.
+    Input(String),
+    /// The run failed (diverged, I/O): exit status 1.
+    Run(String),
+}
+
+impl CliError {
+    pub fn exit_code(&self) -> i32 {
+        match self {
+            CliError::Input(_) => 2,
+            CliError::Run(_) => 1,
+        }
+    }
+    pub fn message(&self) -> &str {
+        match self {
+            CliError::Input(m) | CliError::Run(m) => m,
+        }
+    }
+}
+
+impl From<SceneError> for CliError {
+    fn from(e: SceneError) -> Self {
+        CliError::Input(e.to_string())
+    }
+}
+
+/// Loads a scene and applies the command-line overrides.
+pub fn load_scene(path: &Path, o: &SolverOverrides) -> Result<Scene, CliError> {
+    let mut s = scene::load(path)?;
+    if let Some(m) = o.method {
+        s.params.method = m;
+    }
+    if let Some(m) = o.mode {
+        s.params.mode = m;
+    }
+    if let Some(d) = o.duration {
+        if !(d.is_finite() && d > 0.0) {
+            return Err(CliError::Input(format!(
+                "--duration must be a positive number of seconds, got {d}"
+            )));
+        }
+        s.params.duration = d;
+    }
+    Ok(s)
+}
+
+/// Runs the subcommand the command line asked for.
+pub fn dispatch(cli: &Cli) -> Result<(), CliError> {
+    match &cli.command {
+        CliCommand::Run(args) => run(args),
+        CliCommand::Render(args) => render(args),
+        CliCommand::Generate(args) => generate(args),
+        CliCommand::Bench(args) => bench(args),
+        CliCommand::View(args) => view(args),
+    }
+}
+
+/// The whole binary: parses the process's arguments, runs the subcommand and reports a failure
+/// as `error: …` on stderr. Call it first thing in `main`, before any other thread starts (it
+/// may set an environment variable).
+pub fn main_entry() -> ExitCode {
+    quiet_mesa_runtime_dir();
+    let cli = Cli::parse_from(expand_scene_shorthand(std::env::args_os().collect()));
+    match dispatch(&cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {}", e.message());
+            ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(1))
+        }
+    }
+}
+
+/// Mesa's drivers warn on every start when XDG_RUNTIME_DIR is unset (common over SSH and in CI);
+/// points it at a private temporary directory before any thread or GPU library starts.
+fn quiet_mesa_runtime_dir() {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        let dir = std::env::temp_dir().join("dda3d-xdg-runtime");
+        if std::fs::create_dir_all(&dir).is_ok() {
+            // SAFETY: called from `main_entry` before any other thread exists; nothing reads the
+            // environment concurrently.
+            unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+        }
+    }
+}
+
+/// `dda3d SCENE.toml` is short for `dda3d view SCENE.toml`.
+fn expand_scene_shorthand(mut args: Vec<OsString>) -> Vec<OsString> {
+    if args
+        .get(1)
+        .is_some_and(|a| a.to_string_lossy().ends_with(".toml"))
+    {
+        args.insert(1, "view".into());
+    }
+    args
+}

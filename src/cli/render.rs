@@ -1,0 +1,247 @@
+//! `dda3d render`: simulates headless and writes PNG frames (and optionally an animated GIF)
+//! through the capture pipeline of [`crate::render`], plus render_summary.json.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use clap::Args;
+
+use super::{CliError, Progress, SolverOverrides, load_scene};
+use crate::output::slug;
+use crate::render::{
+    ArrowMode, CameraOverride, CaptureOptions, CaptureReport, Coloring, FrameCapture, Framing,
+    RenderError,
+};
+use crate::solver::{Solver, SolverError};
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    /// Output directory for frame_00000.png …, frames.csv (default: out/<scene name>/frames).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[command(flatten)]
+    pub overrides: SolverOverrides,
+    /// Frames per second of simulated time.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
+    #[arg(long, default_value_t = 1280)]
+    pub width: u32,
+    #[arg(long, default_value_t = 720)]
+    pub height: u32,
+    /// Camera azimuth and elevation in degrees, and optionally distance in m: `az,el[,dist]`.
+    #[arg(long, allow_hyphen_values = true)]
+    pub camera: Option<String>,
+    /// Point the camera looks at, m: `x,y,z` (default: the centre of the framed box).
+    #[arg(long, allow_hyphen_values = true, value_delimiter = ',', num_args = 1)]
+    pub target: Option<Vec<f64>>,
+    /// Block colours: block (one colour per block), velocity, displacement.
+    #[arg(long, default_value = "block")]
+    pub color: String,
+    /// Force arrow scale in N per metre of arrow (default: automatic, fixed after frame 0).
+    #[arg(long)]
+    pub force_scale: Option<f64>,
+    /// Draw contact normals as well as the force arrows.
+    #[arg(long)]
+    pub normals: bool,
+    /// Transparent background.
+    #[arg(long)]
+    pub transparent: bool,
+    /// Re-frame the camera on every frame instead of keeping the first frame's view.
+    #[arg(long)]
+    pub follow: bool,
+    /// Also write an animated GIF, animation.gif.
+    #[arg(long)]
+    pub gif: bool,
+    /// Antialiasing samples (1 or 4).
+    #[arg(long, default_value_t = 4)]
+    pub msaa: u32,
+    #[arg(long, short)]
+    pub quiet: bool,
+}
+
+/// What the simulation side of a render did.
+struct Simulated {
+    /// Wall time spent in the solver, s.
+    seconds: f64,
+    /// The solver error that ended the run early, if any.
+    failure: Option<SolverError>,
+}
+
+/// `dda3d render`: the solver runs on this thread and hands a snapshot to the capture pipeline
+/// (its own render thread and PNG encoder threads) at every frame time, so rendering and encoding
+/// overlap with the simulation. Frames come from the solver's own steps, which are shortened to
+/// land exactly on the frame times, not from re-simulation.
+pub fn render(args: &RenderArgs) -> Result<(), CliError> {
+    let scene = load_scene(&args.scene, &args.overrides)?;
+    check_image_options(args)?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)).join("frames"));
+    let opts = capture_options(args, &out)?;
+    let name = scene.name.clone();
+    let mut solver = Solver::new(scene.model, scene.params);
+    let capture = FrameCapture::start(opts).map_err(|e| match e {
+        RenderError::NoAdapter | RenderError::InvalidOptions(_) => CliError::Input(e.to_string()),
+        other => CliError::Run(other.to_string()),
+    })?;
+    let render_err = |e: RenderError| CliError::Run(format!("{}: {e}", out.display()));
+    let start = Instant::now();
+    let simulated = simulate_frames(&mut solver, &capture, args).map_err(render_err)?;
+    let report = capture.finish().map_err(render_err)?;
+    let wall = start.elapsed().as_secs_f64();
+    write_summary(&out, &name, args, &report, &simulated, wall)?;
+    if let Some(e) = simulated.failure {
+        return Err(CliError::Run(format!(
+            "{}: {e}; {} frames up to t = {:.6} s are in {}",
+            args.scene.display(),
+            report.frames,
+            solver.time,
+            out.display()
+        )));
+    }
+    if !args.quiet {
+        eprintln!(
+            "{name}: {} frames in {:.2} s ({:.1} frames/s; simulation {:.2} s, render+readback {:.1} ms/frame, PNG {:.1} ms/frame on {}); frames in {}",
+            report.frames,
+            wall,
+            report.frames as f64 / wall,
+            simulated.seconds,
+            report.render_ms_per_frame(),
+            report.encode_ms_per_frame(),
+            report.adapter,
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+/// The checks of `--fps`, `--width`/`--height` and `--msaa` that need no GPU.
+fn check_image_options(args: &RenderArgs) -> Result<(), CliError> {
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        return Err(CliError::Input(format!(
+            "--fps must be positive, got {}",
+            args.fps
+        )));
+    }
+    if args.width == 0 || args.height == 0 || args.width > 16384 || args.height > 16384 {
+        return Err(CliError::Input(format!(
+            "--width/--height must lie in 1..=16384, got {}x{}",
+            args.width, args.height
+        )));
+    }
+    if args.msaa != 1 && args.msaa != 4 {
+        return Err(CliError::Input(format!(
+            "--msaa must be 1 or 4, got {}",
+            args.msaa
+        )));
+    }
+    Ok(())
+}
+
+/// The capture pipeline's options from the command line: size, camera, style and framing.
+fn capture_options(args: &RenderArgs, out: &Path) -> Result<CaptureOptions, CliError> {
+    let mut opts = CaptureOptions::new(out);
+    opts.width = args.width;
+    opts.height = args.height;
+    opts.fps = args.fps;
+    opts.gif = args.gif;
+    opts.max_msaa_samples = args.msaa;
+    if let Some(c) = &args.camera {
+        opts.camera =
+            CameraOverride::parse(c).map_err(|e| CliError::Input(format!("--camera: {e}")))?;
+    }
+    if let Some(t) = &args.target {
+        if t.len() != 3 || t.iter().any(|v| !v.is_finite()) {
+            return Err(CliError::Input(
+                "--target needs three finite numbers x,y,z".into(),
+            ));
+        }
+        opts.camera.target = Some([t[0], t[1], t[2]]);
+    }
+    opts.style.coloring =
+        Coloring::parse(&args.color).map_err(|e| CliError::Input(format!("--color: {e}")))?;
+    if let Some(f) = args.force_scale {
+        if !(f.is_finite() && f > 0.0) {
+            return Err(CliError::Input(format!(
+                "--force-scale must be positive, got {f}"
+            )));
+        }
+        opts.style.force_scale = Some(f);
+    }
+    if args.normals {
+        opts.style.arrows = ArrowMode::Both;
+    }
+    opts.style.transparent = args.transparent;
+    if args.follow {
+        opts.framing = Framing::EachFrame;
+    }
+    Ok(opts)
+}
+
+/// Steps the solver to each frame time in turn and submits a snapshot there, frame 0 included.
+/// A solver failure ends the run early and is returned in [`Simulated::failure`]; a capture
+/// failure is the error.
+fn simulate_frames(
+    solver: &mut Solver,
+    capture: &FrameCapture,
+    args: &RenderArgs,
+) -> Result<Simulated, RenderError> {
+    let mut seconds = 0.0;
+    let frame_dt = 1.0 / args.fps;
+    let total_frames = (solver.params.duration * args.fps + 1e-9).floor() as u64 + 1;
+    let mut progress = Progress::new(solver.params.duration, args.quiet);
+    capture.submit(solver.snapshot())?;
+    let mut failure = None;
+    'frames: for k in 1..total_frames {
+        let t = k as f64 * frame_dt;
+        while solver.time < t - 1e-9 * frame_dt {
+            let ts = Instant::now();
+            let r = solver.step_until(t);
+            seconds += ts.elapsed().as_secs_f64();
+            if let Err(e) = r {
+                failure = Some(e);
+                break 'frames;
+            }
+        }
+        capture.submit(solver.snapshot())?;
+        progress.update(solver.time);
+    }
+    progress.finish();
+    Ok(Simulated { seconds, failure })
+}
+
+/// Writes render_summary.json: frame count, size, adapter and where the time went.
+fn write_summary(
+    out: &Path,
+    name: &str,
+    args: &RenderArgs,
+    report: &CaptureReport,
+    simulated: &Simulated,
+    wall: f64,
+) -> Result<(), CliError> {
+    let summary = serde_json::json!({
+        "scene": name,
+        "frames": report.frames,
+        "fps_of_simulated_time": args.fps,
+        "width": args.width,
+        "height": args.height,
+        "adapter": report.adapter,
+        "msaa_samples": report.msaa_samples,
+        "wall_seconds": wall,
+        "frames_per_wall_second": report.frames as f64 / wall,
+        "simulation_seconds": simulated.seconds,
+        "render_seconds": report.render_seconds,
+        "png_encode_seconds": report.encode_seconds,
+        "gif_seconds": report.gif_seconds,
+        "setup_seconds": report.setup_seconds,
+        "status": if simulated.failure.is_some() { "diverged" } else { "completed" },
+    });
+    std::fs::write(
+        out.join("render_summary.json"),
+        serde_json::to_string_pretty(&summary).unwrap_or_default(),
+    )
+    .map_err(|e| CliError::Run(format!("{}: {e}", out.display())))
+}

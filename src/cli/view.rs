@@ -1,0 +1,147 @@
+//! `dda3d view` (and its shorthand `dda3d SCENE.toml`): reads the viewer's flags, loads the
+//! scene, and opens the viewer of [`crate::ui`] with them.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use super::{CliError, SolverOverrides, load_scene};
+use crate::output::slug;
+use crate::ui::sim::Speed;
+use crate::ui::{ViewerError, ViewerOptions, run_viewer};
+
+#[derive(Args, Debug, Clone)]
+pub struct ViewArgs {
+    /// Scene file (TOML).
+    pub scene: PathBuf,
+    #[command(flatten)]
+    pub overrides: SolverOverrides,
+    /// Initial window size in pixels, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    pub size: (u32, u32),
+    /// Simulation speed: a real-time factor (1 = real time, 0.1 = slow motion) or `max`.
+    #[arg(long, default_value = "1", value_parser = parse_speed)]
+    pub speed: Speed,
+    /// Open paused at t = 0 instead of running.
+    #[arg(long)]
+    pub paused: bool,
+    /// Write the whole window (3-D view and panels) to this PNG, then exit (after
+    /// --exit-after-frames frames, default 10).
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// Render this many frames, then exit with status 0 (with --screenshot: write it first).
+    /// Prints the frame time and solver speed on exit.
+    #[arg(long)]
+    pub exit_after_frames: Option<u64>,
+    /// MSAA samples of the 3-D view (1 or 4). Default: 4 on a GPU, 1 on a software
+    /// rasterizer, where 4× costs about three times as much per frame.
+    #[arg(long)]
+    pub msaa: Option<u32>,
+    /// Directory for the screenshot button and recordings (default: out/<scene name>).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Frames rendered before `--screenshot` is taken when `--exit-after-frames` is not given:
+/// enough for egui to settle its layout.
+const DEFAULT_SCREENSHOT_FRAMES: u64 = 10;
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let num = |t: &str| {
+        t.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|v| (64..=16384).contains(v))
+            .ok_or_else(|| format!("window size {s:?}: each side must be 64..=16384 pixels"))
+    };
+    Ok((num(w)?, num(h)?))
+}
+
+fn parse_speed(s: &str) -> Result<Speed, String> {
+    let t = s.trim().to_ascii_lowercase();
+    if t == "max" || t == "fast" {
+        return Ok(Speed::Max);
+    }
+    let t = t.trim_end_matches(['x', '×']);
+    match t.parse::<f64>() {
+        Ok(f) if f.is_finite() && f > 0.0 && f <= 1e6 => Ok(Speed::RealTime(f)),
+        _ => Err(format!(
+            "--speed expects a positive real-time factor (e.g. 1, 0.25) or `max`, got {s:?}"
+        )),
+    }
+}
+
+/// A viewer without a GPU driver is an installation problem, reported like bad input (exit
+/// status 2) as `render` does; any other failure of the window is a failed run.
+impl From<ViewerError> for CliError {
+    fn from(e: ViewerError) -> Self {
+        match e {
+            ViewerError::NoAdapter => CliError::Input(e.to_string()),
+            ViewerError::Failed(m) => CliError::Run(m),
+        }
+    }
+}
+
+/// `dda3d view`.
+pub fn view(args: &ViewArgs) -> Result<(), CliError> {
+    let scene = load_scene(&args.scene, &args.overrides)?;
+    if let Some(n) = args.msaa
+        && !matches!(n, 1 | 4)
+    {
+        return Err(CliError::Input(format!("--msaa must be 1 or 4, got {n}")));
+    }
+    if args.exit_after_frames == Some(0) {
+        return Err(CliError::Input(
+            "--exit-after-frames must be at least 1".into(),
+        ));
+    }
+    if let Some(p) = &args.screenshot
+        && let Some(dir) = p.parent().filter(|d| !d.as_os_str().is_empty())
+        && !dir.is_dir()
+    {
+        return Err(CliError::Input(format!(
+            "--screenshot {}: directory {} does not exist",
+            p.display(),
+            dir.display()
+        )));
+    }
+    let out_dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)));
+    let exit_after = args
+        .exit_after_frames
+        .or(args.screenshot.as_ref().map(|_| DEFAULT_SCREENSHOT_FRAMES));
+    run_viewer(ViewerOptions {
+        scene,
+        size: args.size,
+        speed: args.speed,
+        play: !args.paused,
+        screenshot: args.screenshot.clone(),
+        exit_after_frames: exit_after,
+        msaa: args.msaa,
+        out_dir,
+    })?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_and_speeds_parse() {
+        assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
+        assert_eq!(parse_size("800X600"), Ok((800, 600)));
+        assert!(parse_size("1280").is_err());
+        assert!(parse_size("0x720").is_err());
+        assert_eq!(parse_speed("max"), Ok(Speed::Max));
+        assert_eq!(parse_speed("0.25"), Ok(Speed::RealTime(0.25)));
+        assert_eq!(parse_speed("2x"), Ok(Speed::RealTime(2.0)));
+        assert!(parse_speed("-1").is_err());
+        assert!(parse_speed("fastest").is_err());
+    }
+}
