@@ -2,7 +2,7 @@
 //!
 //! Each frame:
 //! 1. take the newest [`Frame`](super::sim::Frame) from the simulation thread (never waiting);
-//! 2. run the egui UI ([`panel::build`]), which handles camera input and lays out the 3-D view;
+//! 2. run the egui UI ([`panels::build`]), which handles camera input and lays out the 3-D view;
 //! 3. draw the 3-D scene into the view's own texture (`Rgba8Unorm`, which egui can sample and
 //!    the renderer handles by encoding sRGB in its shader), sized to the view in pixels;
 //! 4. draw egui (panels and the view image) into the window surface.
@@ -23,8 +23,9 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy}
 use winit::window::{Window, WindowId};
 
 use super::painter::{EguiPainter, Screen};
-use super::panel::{self, Action, RecordingInfo, UiState};
+use super::panels;
 use super::sim::{Command, RunState, SimHandle, Speed, StepRecord};
+use super::state::{Action, RecordingInfo, UiState};
 use crate::cli::CliError;
 use crate::render::capture::write_png;
 use crate::render::offscreen::{padded_bytes_per_row, strip_row_padding};
@@ -481,7 +482,7 @@ impl Viewer {
         let mut actions = Vec::new();
         let ui_state = &mut self.ui;
         let out = self.egui_ctx.run_ui(raw, |ui| {
-            actions = panel::build(ui, ui_state, texture);
+            actions = panels::build(ui, ui_state, texture);
         });
         self.egui_state
             .handle_platform_output(&self.window, out.platform_output);

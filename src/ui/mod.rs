@@ -2,14 +2,16 @@
 //!
 //! - [`sim`]: the simulation thread and its command/frame protocol;
 //! - [`view`]: camera controls and picking (pure logic);
-//! - [`panel`]: the egui panels (toolbar, parameters, display, selection, plots);
+//! - [`state`]: what the viewer remembers between frames;
+//! - [`panels`]: the egui panels (toolbar, parameters, display, selection, plots, 3-D view);
 //! - [`app`]: the winit window, the wgpu surface and the frame loop;
 //! - [`painter`]: draws egui's meshes with wgpu (fast on software rasterizers).
 
 pub mod app;
 pub mod painter;
-pub mod panel;
+pub mod panels;
 pub mod sim;
+pub mod state;
 pub mod view;
 
 use std::path::PathBuf;
