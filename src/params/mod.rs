@@ -390,6 +390,10 @@ mod tests {
         let readme = include_str!("../../README.md");
         let rows = markdown_rows();
         assert_eq!(rows.lines().count(), ALL.len());
+        for row in rows.lines() {
+            let cells = row.replace("\\|", "").matches('|').count() - 1;
+            assert_eq!(cells, 4, "{row}");
+        }
         for p in ALL {
             assert!(rows.contains(&format!("`{}`", p.name())), "{}", p.key);
             if !NOT_YET_IN_README.contains(&p.name()) {

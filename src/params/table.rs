@@ -213,27 +213,25 @@ impl Param {
 }
 
 /// The README's scene-table rows of every key, in the README's format
-/// (`| table | key | default | meaning |`).
+/// (`| table | key | default | meaning |`): the default with its unit, and the first sentence of
+/// the description.
 pub fn markdown_rows() -> String {
     let mut rows = String::new();
     let mut last_table = "";
     for p in ALL {
         let table = if p.table() == last_table {
-            String::new()
+            " ".to_owned()
         } else {
-            format!("`[{}]`", p.table())
+            format!(" `[{}]` ", p.table())
         };
         last_table = p.table();
-        let unit = if p.unit.is_empty() {
-            String::new()
-        } else {
-            format!(", {}", p.unit)
-        };
         rows += &format!(
-            "| {table} | `{}` | {} | {}{unit} |\n",
+            "|{table}| `{}` | {}{} | {} |\n",
             p.name(),
             markdown_value(p.default),
-            p.summary()
+            p.suffix(),
+            // A '|' of |d_n| would end the cell.
+            p.summary().replace('|', "\\|")
         );
     }
     rows

@@ -12,7 +12,7 @@ mod selection;
 mod solver;
 mod toolbar;
 mod view_3d;
-mod widgets;
+pub mod widgets;
 
 use egui::{Color32, CornerRadius, Key, RichText, Stroke};
 
