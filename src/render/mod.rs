@@ -39,8 +39,7 @@ pub use gpu::{DEPTH_FORMAT, Gpu, OFFSCREEN_FORMAT};
 pub use offscreen::Offscreen;
 pub use overlay::{Overlay, paint_overlay};
 pub use renderer::{RenderTargets, Renderer};
-// `Scene` is the old name of `RenderScene`, kept until its users outside src/render are renamed.
-pub use scene::{ArrowMode, Coloring, RenderScene, Scene, SceneFrame, SceneStyle};
+pub use scene::{ArrowMode, Coloring, RenderScene, SceneFrame, SceneStyle};
 
 /// Everything that can go wrong between a snapshot and a file on disk.
 #[derive(Clone, Debug, thiserror::Error)]

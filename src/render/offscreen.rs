@@ -1,4 +1,4 @@
-//! Off-screen rendering with readback: renders a [`Scene`] into a texture and copies it to a
+//! Off-screen rendering with readback: renders a [`RenderScene`] into a texture and copies it to a
 //! mappable buffer whose rows are padded to wgpu's `COPY_BYTES_PER_ROW_ALIGNMENT` (256 bytes),
 //! then strips the padding. Two readback buffers let the next frame be drawn while the previous
 //! one is being read ([`Offscreen::submit`] / [`Offscreen::read`]).
@@ -10,7 +10,7 @@ use std::sync::mpsc;
 
 use super::camera::Camera;
 use super::overlay::Overlay;
-use super::scene::Scene;
+use super::scene::RenderScene;
 use super::{Gpu, OFFSCREEN_FORMAT, RenderError, RenderTargets, Renderer};
 
 /// Bytes per row of the readback buffer: `width * 4` rounded up to the copy alignment.
@@ -289,7 +289,7 @@ impl Offscreen {
 
     /// Draws the scene and queues its copy to a free readback buffer. At most two frames may
     /// be in flight.
-    pub fn submit(&mut self, scene: &Scene, camera: &Camera) -> Result<Pending, RenderError> {
+    pub fn submit(&mut self, scene: &RenderScene, camera: &Camera) -> Result<Pending, RenderError> {
         let slot = self.slots.iter().position(|s| !s.busy).ok_or_else(|| {
             RenderError::InvalidOptions("two frames already in flight; read one first".into())
         })?;
@@ -340,7 +340,7 @@ impl Offscreen {
     }
 
     /// Renders one frame and waits for it.
-    pub fn render(&mut self, scene: &Scene, camera: &Camera) -> Result<Vec<u8>, RenderError> {
+    pub fn render(&mut self, scene: &RenderScene, camera: &Camera) -> Result<Vec<u8>, RenderError> {
         let p = self.submit(scene, camera)?;
         self.read(p)
     }

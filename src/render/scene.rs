@@ -187,10 +187,6 @@ pub struct RenderScene {
     pub grid_step: Option<f64>,
 }
 
-/// The old name of [`RenderScene`], kept only until `render/offscreen.rs` and the viewer's
-/// panel are renamed (issue #11).
-pub use self::RenderScene as Scene;
-
 /// Background of opaque frames (sRGB): a light grey that prints well and separates white-ish
 /// blocks from the page.
 pub const BACKGROUND_SRGB: u32 = 0xF4F4F1;

@@ -2,7 +2,9 @@
 //!
 //! - [`sim`]: the simulation thread and its command/frame protocol;
 //! - [`view`]: camera controls and picking (pure logic);
-//! - [`panel`]: the egui panels (toolbar, parameters, display, selection, plots);
+//! - [`state`]: what the viewer remembers between frames;
+//! - [`panels`]: the egui panels (toolbar, parameters, display, selection, plots, 3-D view), one
+//!   file each;
 //! - `app/`: the winit application and the frame loop, with its parts: the window and its
 //!   surface, the 3-D view's texture, screenshots and recordings, and frame pacing;
 //! - [`painter`]: draws egui's meshes with wgpu (fast on software rasterizers).
@@ -12,8 +14,9 @@
 
 mod app;
 pub mod painter;
-pub mod panel;
+pub mod panels;
 pub mod sim;
+pub mod state;
 pub mod view;
 
 use std::path::PathBuf;

@@ -22,7 +22,7 @@ use crate::render::{
     CameraOverride, CaptureOptions, FrameCapture, Framing, Gpu, Offscreen, RenderError,
 };
 use crate::ui::ViewerError;
-use crate::ui::panel::{RecordingInfo, UiState};
+use crate::ui::state::{RecordingInfo, UiState};
 
 /// Results of work done off the window thread.
 enum Background {

@@ -2,7 +2,7 @@
 //!
 //! Each frame ([`Viewer::redraw`]):
 //! 1. take the newest [`Frame`](super::sim::Frame) from the simulation thread (never waiting);
-//! 2. run the egui UI ([`panel::build`]), which handles camera input and lays out the 3-D view;
+//! 2. run the egui UI ([`panels::build`]), which handles camera input and lays out the 3-D view;
 //! 3. acquire the window surface's texture;
 //! 4. draw the 3-D scene into the view's own texture (`Rgba8Unorm`, which egui can sample and
 //!    the renderer handles by encoding sRGB in its shader), sized to the view in pixels;
@@ -26,8 +26,9 @@ use winit::event_loop::{ActiveEventLoop, ControlFlow, EventLoop, EventLoopProxy}
 use winit::window::WindowId;
 
 use super::painter::{EguiPainter, Screen};
-use super::panel::{self, Action, UiState};
+use super::panels;
 use super::sim::{Command, RunState, SimHandle, StepRecord};
+use super::state::{Action, UiState};
 use super::{ViewerError, ViewerOptions};
 use crate::render::Gpu;
 use capture::{Capture, WindowCapture};
@@ -328,7 +329,7 @@ impl Viewer {
         let mut actions = Vec::new();
         let ui_state = &mut self.ui;
         let out = self.egui.ctx.run_ui(raw, |ui| {
-            actions = panel::build(ui, ui_state, texture);
+            actions = panels::build(ui, ui_state, texture);
         });
         self.egui
             .state

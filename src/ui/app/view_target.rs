@@ -2,7 +2,7 @@
 //! MSAA and depth attachments, sized to the view in pixels and redrawn only when the picture
 //! changes.
 
-use crate::render::{Camera, Gpu, RenderError, RenderTargets, Renderer, Scene};
+use crate::render::{Camera, Gpu, RenderError, RenderScene, RenderTargets, Renderer};
 use crate::ui::painter::EguiPainter;
 
 /// The colour format of the view texture: non-sRGB like the window (the renderer then encodes
@@ -79,7 +79,7 @@ impl ViewTarget {
         &mut self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
-        scene: &Scene,
+        scene: &RenderScene,
         camera: &Camera,
         version: u64,
     ) -> Result<(), RenderError> {

@@ -2,9 +2,13 @@
 //!
 //! The same struct is filled from the scene file (`[solver]`, `[solver.contact]`, `[joint]`),
 //! overridden from the command line, and edited live by the viewer's panel. Field names match the
-//! scene-file keys.
+//! scene-file keys. [`table`] describes every key once (label, unit, valid range, the panel's
+//! slider range, default, description): `validate`, the panel's sliders and tooltips, and the
+//! README's scene table read it.
 
 use serde::{Deserialize, Serialize};
+
+pub mod table;
 
 /// Shi's step-control rules (reference §6.3, §8). They are part of the method, not tunables; the
 /// solver's step control, the parameter docs and the viewer's tooltips all read them from here.
@@ -26,7 +30,7 @@ pub mod step_rules {
     /// redone with a shorter step. In a struck wall of 1000 blocks the last passes each changed
     /// 2 to 9 of 11 500 contacts, scattered along the wall; each redo threw away 30 global passes
     /// and shortened the following steps (9 redos in its first second). A small model, where one
-    /// contact is more than 1 %, keeps Shi's rule.
+    /// contact is more than this fraction, keeps Shi's rule.
     pub const SETTLE_FRACTION: f64 = 0.01;
 }
 
@@ -90,11 +94,11 @@ pub struct ContactParams {
     pub shear_penalty_ratio: f64,
     /// Cap on ALM iterations per open–close pass (reference §6.2).
     pub max_alm_iterations: u32,
-    /// Open–close passes before the step is redone with 0.3 Δt (reference §6.3). Shi's code
-    /// uses 6 + 2; in a wall of many blocks, lightly loaded joints need 10–25 passes at the
-    /// impact, and a pass costs far less than the steps a cut adds. Where at most 1 % of the
-    /// contacts still change at the limit, they are settled closed and locked instead of the
-    /// step being redone (see the solver's `SETTLE_FRACTION`).
+    /// Open–close passes before the step is redone with [`step_rules::DT_CUT`] · Δt (reference
+    /// §6.3). Shi's code uses 6 + 2; in a wall of many blocks, lightly loaded joints need 10–25
+    /// passes at the impact, and a pass costs far less than the steps a cut adds. Where at most
+    /// [`step_rules::SETTLE_FRACTION`] of the contacts still change at the limit, they are settled
+    /// closed and locked instead of the step being redone.
     pub max_open_close_iterations: u32,
     /// Carry λ and p_n of persisting contacts from one step to the next. The paper is silent;
     /// both converge to the same forces, warm starting needs fewer iterations and keeps the
@@ -165,6 +169,8 @@ impl Default for JointParams {
 
 /// All tunables of a run. The scene file's `[solver]` table, plus `[solver.contact]` and
 /// `[joint]` which live in their own tables.
+///
+/// Each key's description, valid range and default, as users see them: [`table`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverParams {
@@ -215,86 +221,188 @@ impl Default for SolverParams {
 }
 
 impl SolverParams {
-    /// Checks ranges; returns a message naming the offending key.
+    /// Checks every value against the range of its [`table`] entry; returns a message naming the
+    /// offending key. Every number is first checked to be finite, then each against its range,
+    /// both in the table's (the scene file's) order.
     pub fn validate(&self) -> Result<(), String> {
-        let c = &self.contact;
-        let finite = [
-            ("solver.duration", self.duration),
-            ("solver.max_time_step", self.max_time_step),
-            ("solver.max_displacement_ratio", self.max_displacement_ratio),
-            ("solver.gravity", self.gravity[0]),
-            ("solver.gravity", self.gravity[1]),
-            ("solver.gravity", self.gravity[2]),
-            ("solver.fixed_spring_factor", self.fixed_spring_factor),
-            (
-                "solver.max_displacement_overshoot",
-                self.max_displacement_overshoot,
-            ),
-            ("solver.contact.initial_penalty", c.initial_penalty),
-            ("solver.contact.alpha", c.alpha),
-            ("solver.contact.beta", c.beta),
-            ("solver.contact.gamma", c.gamma),
-            ("solver.contact.eps1", c.eps1),
-            ("solver.contact.eps2", c.eps2),
-            ("solver.contact.shear_penalty_ratio", c.shear_penalty_ratio),
-            ("solver.contact.close_threshold", c.close_threshold),
-            ("solver.contact.open_threshold", c.open_threshold),
-            ("joint.friction_angle", self.joint.friction_angle),
-            ("joint.cohesion", self.joint.cohesion),
-        ];
-        for (key, v) in finite {
-            if !v.is_finite() {
-                return Err(format!("{key} must be a finite number, got {v}"));
-            }
+        for p in table::ALL {
+            p.check_finite(self)?;
         }
-        let positive = [
-            ("solver.duration", self.duration),
-            ("solver.max_time_step", self.max_time_step),
-            ("solver.max_displacement_ratio", self.max_displacement_ratio),
-            ("solver.fixed_spring_factor", self.fixed_spring_factor),
-            ("solver.contact.initial_penalty", c.initial_penalty),
-            ("solver.contact.gamma", c.gamma),
-            ("solver.contact.eps1", c.eps1),
-            ("solver.contact.eps2", c.eps2),
-            ("solver.contact.shear_penalty_ratio", c.shear_penalty_ratio),
-        ];
-        for (key, v) in positive {
-            if v <= 0.0 {
-                return Err(format!("{key} must be positive, got {v}"));
-            }
-        }
-        if c.alpha <= 1.0 {
-            return Err(format!("solver.contact.alpha must be > 1, got {}", c.alpha));
-        }
-        if !(c.beta > 0.0 && c.beta < 1.0) {
-            return Err(format!(
-                "solver.contact.beta must lie in (0, 1), got {}",
-                c.beta
-            ));
-        }
-        if self.max_displacement_overshoot < 1.0 {
-            return Err(format!(
-                "solver.max_displacement_overshoot must be at least 1, got {}",
-                self.max_displacement_overshoot
-            ));
-        }
-        if c.close_threshold < 0.0 || c.open_threshold < 0.0 {
-            return Err(
-                "solver.contact.close_threshold and open_threshold must not be negative".into(),
-            );
-        }
-        if c.max_alm_iterations == 0 || c.max_open_close_iterations == 0 {
-            return Err("solver.contact iteration limits must be at least 1".into());
-        }
-        if !(0.0..90.0).contains(&self.joint.friction_angle) {
-            return Err(format!(
-                "joint.friction_angle must lie in [0, 90) degrees, got {}",
-                self.joint.friction_angle
-            ));
-        }
-        if self.joint.cohesion < 0.0 {
-            return Err("joint.cohesion must not be negative".into());
+        for p in table::ALL {
+            p.check_range(self)?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::table::*;
+    use super::*;
+
+    /// The scene file's keys of every field, from serde, so that a new field cannot be missed.
+    fn scene_keys() -> Vec<String> {
+        let mut keys = Vec::new();
+        let solver = serde_json::to_value(SolverParams::default()).unwrap();
+        for (name, v) in solver.as_object().unwrap() {
+            match v.as_object() {
+                Some(table) => keys.extend(table.keys().map(|k| format!("solver.{name}.{k}"))),
+                None => keys.push(format!("solver.{name}")),
+            }
+        }
+        let joint = serde_json::to_value(JointParams::default()).unwrap();
+        keys.extend(
+            joint
+                .as_object()
+                .unwrap()
+                .keys()
+                .map(|k| format!("joint.{k}")),
+        );
+        keys
+    }
+
+    #[test]
+    fn every_field_has_one_entry() {
+        let mut keys = scene_keys();
+        let mut table: Vec<String> = ALL.iter().map(|p| p.key.to_owned()).collect();
+        keys.sort();
+        table.sort();
+        assert_eq!(table, keys);
+    }
+
+    #[test]
+    fn defaults_match_the_structs_and_are_valid() {
+        let d = SolverParams::default();
+        for p in ALL {
+            assert_eq!(p.default, (p.get)(&d), "{}", p.key);
+        }
+        assert_eq!(d.validate(), Ok(()));
+    }
+
+    /// A scene that sets `key` to the TOML literal `value`.
+    fn scene_with(p: &Param, value: &str) -> String {
+        format!(
+            "[materials.rock]\ndensity = 2750.0\nyoung_modulus = 2.0e10\npoisson_ratio = 0.25\n\
+             [[blocks]]\nname = \"a\"\nmaterial = \"rock\"\n\
+             box = {{ size = [1, 1, 1], center = [0, 0, 0.5] }}\n\
+             [{}]\n{} = {value}\n",
+            p.table(),
+            p.name()
+        )
+    }
+
+    /// Values just outside an interval, below and above.
+    fn outside(i: Interval) -> Vec<f64> {
+        let nudge = |x: f64| 1e-9 * x.abs().max(1.0);
+        let mut v = Vec::new();
+        match i.lo {
+            Bound::Unbounded => {}
+            Bound::Open(x) => v.push(x),
+            Bound::Closed(x) => v.push(x - nudge(x)),
+        }
+        match i.hi {
+            Bound::Unbounded => {}
+            Bound::Open(x) => v.push(x),
+            Bound::Closed(x) => v.push(x + nudge(x)),
+        }
+        v
+    }
+
+    #[test]
+    fn values_outside_a_range_are_rejected_naming_the_key() {
+        let mut checked = 0;
+        for p in ALL {
+            let values: Vec<String> = match p.default {
+                Value::Real(_) => outside(p.valid).iter().map(|x| format!("{x:?}")).collect(),
+                Value::Count(_) => outside(p.valid)
+                    .iter()
+                    .map(|x| x.floor().to_string())
+                    .collect(),
+                _ => continue,
+            };
+            for value in values {
+                let text = scene_with(p, &value);
+                let e = crate::scene::parse(&text, "s.toml", "s").expect_err(&text);
+                assert!(e.message.contains(p.key), "{}: {e}", p.key);
+                checked += 1;
+            }
+            if let Value::Real(_) = p.default {
+                let e = crate::scene::parse(&scene_with(p, "nan"), "s.toml", "s").unwrap_err();
+                assert!(
+                    e.message.contains(p.key) && e.message.contains("finite"),
+                    "{e}"
+                );
+            }
+            // The default, written into a scene, is accepted.
+            if let Value::Real(x) = p.default {
+                crate::scene::parse(&scene_with(p, &format!("{x:?}")), "s.toml", "s").unwrap();
+            }
+        }
+        assert!(checked >= 18, "every bounded number is checked ({checked})");
+        let mut bad = SolverParams::default();
+        bad.contact.beta = 1.5;
+        assert_eq!(
+            bad.validate(),
+            Err("solver.contact.beta must lie in (0, 1), got 1.5".into())
+        );
+        bad.contact.beta = f64::NAN;
+        assert_eq!(
+            bad.validate(),
+            Err("solver.contact.beta must be a finite number, got NaN".into())
+        );
+    }
+
+    #[test]
+    fn widget_ranges_lie_within_the_valid_ranges() {
+        let young = 2.0e10;
+        for p in ALL.iter().filter(|p| p.widget.is_some()) {
+            let r = p.widget_range(young);
+            assert!(r.start() < r.end(), "{}", p.key);
+            assert!(
+                p.valid.contains(*r.start()) && p.valid.contains(*r.end()),
+                "{}",
+                p.key
+            );
+            if let Value::Real(d) = p.default {
+                assert!(r.contains(&d), "{}: the default is on the slider", p.key);
+            }
+        }
+    }
+
+    #[test]
+    fn docs_write_out_the_step_rules() {
+        for p in ALL {
+            assert!(!p.doc().contains('{'), "{}: {}", p.key, p.doc());
+        }
+        let passes = MAX_OPEN_CLOSE_ITERATIONS.doc();
+        assert!(
+            passes.contains("0.3·Δt") && passes.contains("at most 1 %"),
+            "{passes}"
+        );
+        assert!(MAX_TIME_STEP.doc().contains("≤ 1.3×"));
+    }
+
+    /// Keys the README's scene table does not have yet.
+    const NOT_YET_IN_README: [&str; 1] = ["open_threshold"];
+
+    #[test]
+    fn the_readme_documents_every_key() {
+        let readme = include_str!("../../README.md");
+        let rows = markdown_rows();
+        assert_eq!(rows.lines().count(), ALL.len());
+        for row in rows.lines() {
+            let cells = row.replace("\\|", "").matches('|').count() - 1;
+            assert_eq!(cells, 4, "{row}");
+        }
+        for p in ALL {
+            assert!(rows.contains(&format!("`{}`", p.name())), "{}", p.key);
+            if !NOT_YET_IN_README.contains(&p.name()) {
+                assert!(
+                    readme.contains(&format!("`{}`", p.name())),
+                    "README lacks {}",
+                    p.key
+                );
+            }
+        }
     }
 }

@@ -1,0 +1,179 @@
+//! The toolbar: play/step/reset, simulation speed, simulated time and run state, frame rate,
+//! and the record and screenshot buttons.
+
+use egui::{Align, Color32, Layout, RichText};
+
+use super::widgets::{ERROR_RED, Icon, OK_GREEN, icon_button, num, seconds};
+use crate::render::overlay::format_time;
+use crate::ui::sim::{Command, Frame, RunState, Speed};
+use crate::ui::state::{Action, UiState};
+
+const SPEEDS: [f64; 8] = [0.05, 0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0];
+
+fn speed_label(s: Speed) -> String {
+    match s {
+        Speed::Max => "as fast as possible".into(),
+        Speed::RealTime(f) if (f - 1.0).abs() < 1e-12 => "real time (1×)".into(),
+        Speed::RealTime(f) => format!("{}× real time", num(f)),
+    }
+}
+
+pub fn show(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
+    let Some(frame) = state.frame.clone() else {
+        ui.label("starting...");
+        return;
+    };
+    ui.horizontal(|ui| {
+        ui.spacing_mut().item_spacing.x = 6.0;
+        run_buttons(ui, &frame, actions);
+        ui.separator();
+        speed_box(ui, state, actions);
+        ui.separator();
+        progress(ui, &frame);
+        ui.with_layout(Layout::right_to_left(Align::Center), |ui| {
+            rates(ui, state, &frame);
+            ui.separator();
+            capture_buttons(ui, state, actions);
+        });
+    });
+}
+
+/// Play/Pause, Step and Reset.
+fn run_buttons(ui: &mut egui::Ui, frame: &Frame, actions: &mut Vec<Action>) {
+    let is_running = frame.state == RunState::Running;
+    let (icon, text) = if is_running {
+        (Icon::Pause, "Pause")
+    } else {
+        (Icon::Play, "Play")
+    };
+    let tip = if frame.state == RunState::Finished {
+        "Continue past the end time (by another scene duration)  [Space]"
+    } else {
+        "Run / pause the simulation  [Space]"
+    };
+    let fill = (!is_running).then_some(Color32::from_rgb(0xD5, 0xEC, 0xD9));
+    if icon_button(ui, 84.0, icon, text, fill)
+        .on_hover_text(tip)
+        .clicked()
+    {
+        actions.push(Action::Sim(if is_running {
+            Command::Pause
+        } else {
+            Command::Play
+        }));
+    }
+    if icon_button(ui, 70.0, Icon::Step, "Step", None)
+        .on_hover_text("Advance one time step, then pause  [Right arrow or S]")
+        .clicked()
+    {
+        actions.push(Action::Sim(Command::Step));
+    }
+    if icon_button(ui, 74.0, Icon::Reset, "Reset", None)
+        .on_hover_text("Back to t = 0 with the current parameters  [R]")
+        .clicked()
+    {
+        actions.push(Action::Sim(Command::Reset));
+    }
+}
+
+/// The simulation speed (a real-time factor, or as fast as possible).
+fn speed_box(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
+    ui.label("Speed");
+    let before = state.speed;
+    egui::ComboBox::from_id_salt("speed")
+        .width(150.0)
+        .selected_text(speed_label(state.speed))
+        .show_ui(ui, |ui| {
+            for f in SPEEDS {
+                ui.selectable_value(
+                    &mut state.speed,
+                    Speed::RealTime(f),
+                    speed_label(Speed::RealTime(f)),
+                );
+            }
+            ui.selectable_value(&mut state.speed, Speed::Max, speed_label(Speed::Max));
+        })
+        .response
+        .on_hover_text(
+            "Simulated seconds per wall-clock second. \"As fast as possible\" steps back \
+             to back; the window keeps drawing the newest state.",
+        );
+    if state.speed != before {
+        actions.push(Action::Sim(Command::SetSpeed(state.speed)));
+    }
+}
+
+/// Simulated time, step, Δt, cuts and the run state.
+fn progress(ui: &mut egui::Ui, frame: &Frame) {
+    let snap = &frame.snapshot;
+    ui.label(RichText::new(format!("t = {}", format_time(snap.time))).strong())
+        .on_hover_text("Simulated time");
+    ui.label(RichText::new(format!("/ {}", format_time(frame.params.duration))).weak())
+        .on_hover_text("End time: the run pauses here; Play continues past it");
+    ui.label(format!("step {}", snap.step));
+    ui.label(format!("Δt {}", seconds(snap.stats.time_step)))
+        .on_hover_text("Length of the last accepted step");
+    ui.label(format!("cuts {}", frame.totals.time_step_cuts))
+        .on_hover_text(
+            "Time-step cuts so far: attempts redone with a smaller Δt (displacement over \
+             δ·w0, or open–close not converging)",
+        );
+    ui.separator();
+    let (text, color) = match frame.state {
+        RunState::Running => ("RUNNING", OK_GREEN),
+        RunState::Paused => ("PAUSED", Color32::from_gray(90)),
+        RunState::Finished => ("AT END TIME", Color32::from_rgb(0x2F, 0x5F, 0xB0)),
+        RunState::Failed => ("SOLVER ERROR", ERROR_RED),
+    };
+    ui.label(RichText::new(text).strong().color(color));
+}
+
+/// Frames per second of the window and steps per second of the solver.
+fn rates(ui: &mut egui::Ui, state: &UiState, frame: &Frame) {
+    let (interval, busy) = state.perf.recent_ms();
+    let fps = if interval > 0.0 { 1e3 / interval } else { 0.0 };
+    let sps = frame.steps_per_second;
+    ui.label(
+        RichText::new(format!(
+            "{fps:.0} fps · {} steps/s",
+            if sps > 0.0 {
+                num(sps.round())
+            } else {
+                "–".into()
+            }
+        ))
+        .monospace()
+        .weak(),
+    )
+    .on_hover_text(format!(
+        "Window: {interval:.1} ms between frames, {busy:.1} ms of CPU per frame.\n\
+         Solver: {} per step.\nGPU: {}",
+        seconds(frame.seconds_per_step),
+        state.adapter
+    ));
+}
+
+/// Record (or Stop) and Screenshot, laid out right to left.
+fn capture_buttons(ui: &mut egui::Ui, state: &UiState, actions: &mut Vec<Action>) {
+    let rec = state.recording.is_some();
+    let (icon, text) = if rec {
+        (Icon::Stop, "Stop")
+    } else {
+        (Icon::Record, "Record")
+    };
+    if icon_button(ui, 84.0, icon, text, None)
+        .on_hover_text(
+            "Write a PNG of the 3-D view for every new step shown while running \
+             (window size, camera fixed at the start), plus frames.csv",
+        )
+        .clicked()
+    {
+        actions.push(Action::ToggleRecord);
+    }
+    if icon_button(ui, 112.0, Icon::Camera, "Screenshot", None)
+        .on_hover_text("Write the 3-D view at window size as a PNG")
+        .clicked()
+    {
+        actions.push(Action::Screenshot);
+    }
+}

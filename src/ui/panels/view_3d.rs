@@ -1,0 +1,254 @@
+//! The 3-D view: the rendered image, camera input and picking, and what egui draws over it
+//! (the selected block's outline, block labels, the legend overlay, the selection card and the
+//! status toasts).
+
+use std::time::Duration;
+
+use egui::{Align2, Color32, FontId, PointerButton, Pos2, Rect, Sense, Stroke, Vec2};
+use glam::DVec3;
+
+use super::widgets::{ACCENT, ERROR_RED, length, num};
+use crate::render::overlay::format_force;
+use crate::render::paint_overlay;
+use crate::snapshot::{BlockSnapshot, ContactState, Snapshot};
+use crate::ui::state::UiState;
+use crate::ui::view::DragButton;
+
+pub fn show(ui: &mut egui::Ui, state: &mut UiState, texture: egui::TextureId) {
+    let rect = ui.max_rect();
+    state.view_rect = rect;
+    state.view.set_viewport(rect.width(), rect.height());
+    let response = ui.allocate_rect(rect, Sense::click_and_drag());
+    camera_input(ui, state, &response, rect);
+
+    let painter = ui.painter_at(rect);
+    painter.image(
+        texture,
+        rect,
+        Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0)),
+        Color32::WHITE,
+    );
+    let Some(frame) = state.frame.clone() else {
+        return;
+    };
+    let snap = &frame.snapshot;
+    let (w, h) = (rect.width(), rect.height());
+    let to_screen = |p: [f64; 3]| {
+        state
+            .view
+            .project(p, w, h)
+            .map(|(x, y)| rect.min + Vec2::new(x, y))
+    };
+    if let Some(b) = state.selected.and_then(|i| snap.blocks.get(i)) {
+        outline(&painter, b, &to_screen);
+    }
+    if state.display.labels {
+        block_labels(&painter, rect, snap, state.selected, &to_screen);
+    }
+
+    if let Some(scene) = &state.scene
+        && scene.overlay
+    {
+        paint_overlay(&painter, scene, &state.view.camera, rect);
+    }
+
+    if let Some(i) = state.selected
+        && let Some(b) = snap.blocks.get(i)
+    {
+        selection_card(&painter, rect, state, snap, i, b);
+    }
+    status_toasts(ui, &painter, rect, state);
+
+    if response.hovered() && !response.dragged() {
+        ui.ctx().set_cursor_icon(egui::CursorIcon::Crosshair);
+    }
+}
+
+/// Orbit, pan and zoom the camera, and select the block under a click.
+fn camera_input(ui: &egui::Ui, state: &mut UiState, response: &egui::Response, rect: Rect) {
+    let (w, h) = (rect.width(), rect.height());
+    let delta = response.drag_delta();
+    if response.dragged_by(PointerButton::Primary) {
+        state.view.drag(DragButton::Left, delta.x, delta.y, h);
+    } else if response.dragged_by(PointerButton::Secondary) {
+        state.view.drag(DragButton::Right, delta.x, delta.y, h);
+    } else if response.dragged_by(PointerButton::Middle) {
+        state.view.drag(DragButton::Middle, delta.x, delta.y, h);
+    }
+    if response.hovered() {
+        let scroll = ui.input(|i| i.smooth_scroll_delta.y);
+        if scroll != 0.0 {
+            state.view.scroll(scroll);
+        }
+    }
+    if response.clicked()
+        && let (Some(pos), Some(f)) = (response.interact_pointer_pos(), &state.frame)
+    {
+        let p = pos - rect.min;
+        state.selected = state.view.pick(&f.snapshot, p.x, p.y, w, h);
+    }
+}
+
+/// The selected block's outline, on top of everything (drawn through other blocks on purpose, so
+/// a block hidden behind others can still be followed).
+fn outline(
+    painter: &egui::Painter,
+    b: &BlockSnapshot,
+    to_screen: &impl Fn([f64; 3]) -> Option<Pos2>,
+) {
+    let pts: Vec<Option<Pos2>> = b.vertices.iter().map(|v| to_screen(*v)).collect();
+    let stroke = Stroke::new(2.5, ACCENT);
+    for face in &b.faces {
+        for k in 0..face.len() {
+            let (a, c) = (face[k] as usize, face[(k + 1) % face.len()] as usize);
+            if a < c
+                && let (Some(Some(p)), Some(Some(q))) = (pts.get(a), pts.get(c))
+            {
+                painter.line_segment([*p, *q], stroke);
+            }
+        }
+    }
+    if let Some(c) = to_screen(b.centroid) {
+        painter.circle_filled(c, 3.5, ACCENT);
+    }
+}
+
+/// Block names at their centroids (the first 300 blocks; the selected one in the accent colour).
+fn block_labels(
+    painter: &egui::Painter,
+    rect: Rect,
+    snap: &Snapshot,
+    selected: Option<usize>,
+    to_screen: &impl Fn([f64; 3]) -> Option<Pos2>,
+) {
+    for (i, b) in snap.blocks.iter().enumerate().take(300) {
+        if let Some(c) = to_screen(b.centroid)
+            && rect.contains(c)
+        {
+            let color = if selected == Some(i) {
+                ACCENT
+            } else {
+                Color32::from_gray(20)
+            };
+            let galley = painter.layout_no_wrap(b.name.clone(), FontId::proportional(13.0), color);
+            let r = Align2::CENTER_CENTER.anchor_size(c, galley.size());
+            painter.rect_filled(
+                r.expand(2.0),
+                3.0,
+                Color32::from_rgba_unmultiplied(255, 255, 255, 190),
+            );
+            painter.galley(r.min, galley, color);
+        }
+    }
+}
+
+/// A translucent card with lines of text, anchored at `anchor` of `rect` (inset by a margin).
+fn card(painter: &egui::Painter, rect: Rect, anchor: Align2, lines: &[(String, Color32, bool)]) {
+    let galleys: Vec<_> = lines
+        .iter()
+        .map(|(t, c, strong)| {
+            let font = if *strong {
+                FontId::proportional(15.0)
+            } else {
+                FontId::proportional(13.0)
+            };
+            painter.layout_no_wrap(t.clone(), font, *c)
+        })
+        .collect();
+    let w = galleys.iter().map(|g| g.size().x).fold(0.0, f32::max);
+    let h: f32 = galleys.iter().map(|g| g.size().y + 2.0).sum();
+    let pad = 18.0;
+    let inner = rect.shrink(pad);
+    let r = anchor.align_size_within_rect(Vec2::new(w, h), inner);
+    painter.rect_filled(
+        r.expand(7.0),
+        5.0,
+        Color32::from_rgba_unmultiplied(255, 255, 255, 215),
+    );
+    let mut y = r.min.y;
+    for (g, (_, c, _)) in galleys.into_iter().zip(lines) {
+        let gh = g.size().y;
+        painter.galley(Pos2::new(r.min.x, y), g, *c);
+        y += gh + 2.0;
+    }
+}
+
+/// The selected block's vital numbers, top right of the view (the full contact list is in
+/// the panel).
+fn selection_card(
+    painter: &egui::Painter,
+    rect: Rect,
+    state: &UiState,
+    snap: &Snapshot,
+    i: usize,
+    b: &BlockSnapshot,
+) {
+    let text = Color32::from_gray(25);
+    let dim = Color32::from_gray(80);
+    let u = DVec3::from_array(b.displacement).length();
+    let v = DVec3::from_array(b.velocity).length();
+    let contacts: Vec<_> = snap
+        .contacts
+        .iter()
+        .filter(|c| c.block_i == i || c.block_j == i)
+        .collect();
+    let n: f64 = contacts.iter().map(|c| c.normal_force).sum();
+    let sliding = contacts
+        .iter()
+        .filter(|c| c.state == ContactState::Slide)
+        .count();
+    let mut lines = vec![(
+        format!("{}{}", b.name, if b.fixed { " (fixed)" } else { "" }),
+        ACCENT,
+        true,
+    )];
+    if let Some(info) = state.scene_file.blocks.get(i) {
+        lines.push((format!("mass {} kg", num(info.mass)), dim, false));
+    }
+    lines.push((
+        format!("|u| = {}    |v| = {} m/s", length(u), num(v)),
+        text,
+        false,
+    ));
+    lines.push((
+        format!(
+            "{} contacts ({} sliding), Σ N = {}",
+            contacts.len(),
+            sliding,
+            format_force(n)
+        ),
+        text,
+        false,
+    ));
+    lines.push(("details in the panel · Esc to clear".into(), dim, false));
+    card(painter, rect, Align2::RIGHT_TOP, &lines);
+}
+
+/// Recording indicator and the latest message, bottom centre of the view.
+fn status_toasts(ui: &egui::Ui, painter: &egui::Painter, rect: Rect, state: &UiState) {
+    let mut lines = Vec::new();
+    if let Some(r) = &state.recording {
+        lines.push((
+            format!("REC  {} frames to {}", r.frames, r.dir.display()),
+            ERROR_RED,
+            true,
+        ));
+    }
+    const SHOW: Duration = Duration::from_secs(8);
+    if let Some(m) = &state.message {
+        let age = m.at.elapsed();
+        if age < SHOW {
+            let c = if m.error {
+                ERROR_RED
+            } else {
+                Color32::from_gray(40)
+            };
+            lines.push((m.text.clone(), c, false));
+            // Redraw when it should disappear, even if nothing else moves.
+            ui.ctx().request_repaint_after(SHOW - age);
+        }
+    }
+    if !lines.is_empty() {
+        card(painter, rect, Align2::CENTER_BOTTOM, &lines);
+    }
+}
