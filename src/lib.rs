@@ -12,7 +12,7 @@
 //!                        │  uses physics (geometry, mechanics, linear) and contact
 //!                        ▼
 //!                     snapshot ──▶ output (CSV, JSON)
-//!                              └─▶ render (wgpu) ──▶ ui (the viewer)
+//!                              └─▶ render (wgpu) ──▶ viewer (egui, winit)
 //! ```
 //!
 //! [`params`] holds every tunable; [`cli`] is the binary's front end, [`generate`] and [`bench`]
@@ -30,4 +30,4 @@ pub mod render;
 pub mod scene;
 pub mod snapshot;
 pub mod solver;
-pub mod ui;
+pub mod viewer;

@@ -1,5 +1,5 @@
 //! `dda3d view` (and its shorthand `dda3d SCENE.toml`): reads the viewer's flags, loads the
-//! scene, and opens the viewer of [`crate::ui`] with them.
+//! scene, and opens the viewer of [`crate::viewer`] with them.
 
 use std::path::PathBuf;
 
@@ -7,8 +7,8 @@ use clap::Args;
 
 use super::{CliError, SolverOverrides, load_scene};
 use crate::output::slug;
-use crate::ui::sim::Speed;
-use crate::ui::{ViewerError, ViewerOptions, run_viewer};
+use crate::viewer::sim::Speed;
+use crate::viewer::{ViewerError, ViewerOptions, run_viewer};
 
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {

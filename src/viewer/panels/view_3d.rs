@@ -11,8 +11,8 @@ use super::widgets::{ACCENT, ERROR_RED, length, num};
 use crate::render::overlay::format_force;
 use crate::render::paint_overlay;
 use crate::snapshot::{BlockSnapshot, ContactState, Snapshot};
-use crate::ui::state::UiState;
-use crate::ui::view::DragButton;
+use crate::viewer::state::UiState;
+use crate::viewer::view::DragButton;
 
 pub fn show(ui: &mut egui::Ui, state: &mut UiState, texture: egui::TextureId) {
     let rect = ui.max_rect();

@@ -7,8 +7,8 @@ use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints};
 use super::widgets::{ACCENT, color32, num};
 use crate::params::{Method, SolverParams};
 use crate::render::mesh::{LOCK_SRGB, OPEN_SRGB, SLIDE_SRGB};
-use crate::ui::sim::StepRecord;
-use crate::ui::state::UiState;
+use crate::viewer::sim::StepRecord;
+use crate::viewer::state::UiState;
 
 /// Points per plotted line: about one per pixel of a plot's width. Each point becomes several
 /// anti-aliased triangles, and on a software rasterizer triangles, not pixels, dominate the cost
@@ -213,7 +213,7 @@ fn kinetic_energy(ui: &mut egui::Ui, recs: &[StepRecord], h: f32) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ui::state::tests::rec;
+    use crate::viewer::state::tests::rec;
 
     #[test]
     fn downsampling_keeps_spikes() {

@@ -7,7 +7,7 @@ use egui::RichText;
 use super::widgets::{length, num, param_label, param_slider, seconds};
 use crate::params::table::{self, Value};
 use crate::params::{Method, Mode, SolverParams};
-use crate::ui::state::UiState;
+use crate::viewer::state::UiState;
 
 /// The paper's p_n,1 = 0.01 E (§3.1), the "Paper defaults" button's initial penalty.
 const PAPER_PENALTY_PER_E: f64 = 0.01;

@@ -412,7 +412,7 @@ pub(super) mod tests {
     use super::*;
 
     /// A step record with penetration `pen` (the plots' tests use it too).
-    pub(in crate::ui) fn rec(step: u64, pen: f64) -> StepRecord {
+    pub(in crate::viewer) fn rec(step: u64, pen: f64) -> StepRecord {
         StepRecord {
             generation: 0,
             step,

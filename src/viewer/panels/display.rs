@@ -6,8 +6,8 @@ use egui::RichText;
 use super::widgets::slider;
 use crate::render::Coloring;
 use crate::render::overlay::format_force;
-use crate::ui::state::UiState;
-use crate::ui::view::ViewControls;
+use crate::viewer::state::UiState;
+use crate::viewer::view::ViewControls;
 
 pub fn show(ui: &mut egui::Ui, state: &mut UiState) {
     let d = &mut state.display;

@@ -21,8 +21,8 @@ use crate::render::offscreen::{ChannelOrder, Readback, readable_target};
 use crate::render::{
     CameraOverride, CaptureOptions, FrameCapture, Framing, Gpu, Offscreen, RenderError,
 };
-use crate::ui::ViewerError;
-use crate::ui::state::{RecordingInfo, UiState};
+use crate::viewer::ViewerError;
+use crate::viewer::state::{RecordingInfo, UiState};
 
 /// Results of work done off the window thread.
 enum Background {

@@ -4,7 +4,7 @@
 
 use std::time::{Duration, Instant};
 
-use crate::ui::sim::{Frame, RunState};
+use crate::viewer::sim::{Frame, RunState};
 
 /// On a software rasterizer, drawing competes with the solver for the same cores: animation is
 /// capped at 40 frames/s there, which keeps the window above 30 frames/s while the solver gets the

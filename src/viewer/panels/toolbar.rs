@@ -5,8 +5,8 @@ use egui::{Align, Color32, Layout, RichText};
 
 use super::widgets::{ERROR_RED, Icon, OK_GREEN, icon_button, num, seconds};
 use crate::render::overlay::format_time;
-use crate::ui::sim::{Command, Frame, RunState, Speed};
-use crate::ui::state::{Action, UiState};
+use crate::viewer::sim::{Command, Frame, RunState, Speed};
+use crate::viewer::state::{Action, UiState};
 
 const SPEEDS: [f64; 8] = [0.05, 0.1, 0.25, 0.5, 1.0, 2.0, 5.0, 10.0];
 

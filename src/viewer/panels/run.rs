@@ -1,7 +1,7 @@
 //! Run statistics: the solver's totals since t = 0, and the GPU in use.
 
 use super::widgets::{length, seconds};
-use crate::ui::state::UiState;
+use crate::viewer::state::UiState;
 
 pub fn show(ui: &mut egui::Ui, state: &UiState) {
     let Some(f) = state.frame.clone() else {

@@ -8,8 +8,8 @@ use winit::event_loop::ActiveEventLoop;
 use winit::window::Window;
 
 use crate::render::Gpu;
-use crate::ui::ViewerError;
-use crate::ui::painter::EguiPainter;
+use crate::viewer::ViewerError;
+use crate::viewer::painter::EguiPainter;
 
 /// The window, its surface and the surface's configuration.
 pub(super) struct WindowSurface {

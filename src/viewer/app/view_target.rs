@@ -3,7 +3,7 @@
 //! changes.
 
 use crate::render::{Camera, Gpu, RenderError, RenderScene, RenderTargets, Renderer};
-use crate::ui::painter::EguiPainter;
+use crate::viewer::painter::EguiPainter;
 
 /// The colour format of the view texture: non-sRGB like the window (the renderer then encodes
 /// sRGB in its shader), so egui shows its bytes as they are.

@@ -7,7 +7,7 @@ use super::widgets::{color32, length, num};
 use crate::render::mesh::{LOCK_SRGB, OPEN_SRGB, SLIDE_SRGB};
 use crate::render::overlay::format_force;
 use crate::snapshot::{BlockSnapshot, ContactMode, ContactSnapshot, ContactState, Snapshot};
-use crate::ui::state::{BlockInfo, UiState};
+use crate::viewer::state::{BlockInfo, UiState};
 
 pub fn show(ui: &mut egui::Ui, state: &UiState) {
     let Some(frame) = state.frame.clone() else {
