@@ -244,6 +244,18 @@ mod tests {
         (solver, active, pairs)
     }
 
+    /// K assembled afresh for a step of 0.01 s: the block terms and every closed contact.
+    fn assemble_fresh(solver: &Solver, active: &[Active], k: &mut BlockMatrix) {
+        let (k0, _) = block_terms(&solver.params, &solver.model.blocks, 0.01);
+        k.diag.copy_from_slice(&k0);
+        for c in active {
+            if let Some(key) = c.stiffness_key() {
+                let (cp, blocks) = (&solver.params.contact, &solver.model.blocks);
+                apply_stiffness(k, cp, blocks, c, &key, 1.0);
+            }
+        }
+    }
+
     /// The assembled global matrix — block terms, fixed-point springs, and contacts in all three
     /// closed configurations (normal + shear spring, normal + friction) of both entrance modes —
     /// is symmetric and positive definite (reference §7), so Cholesky applies.
@@ -280,20 +292,7 @@ mod tests {
                 .try_normalize(1e-9)
                 .unwrap_or(Vec3::x());
         }
-        let (k0, _) = block_terms(&solver.params, &solver.model.blocks, 0.01);
-        k.diag.copy_from_slice(&k0);
-        for c in &active {
-            if let Some(key) = c.stiffness_key() {
-                apply_stiffness(
-                    &mut k,
-                    &solver.params.contact,
-                    &solver.model.blocks,
-                    c,
-                    &key,
-                    1.0,
-                );
-            }
-        }
+        assemble_fresh(&solver, &active, &mut k);
         let n = 12 * solver.model.blocks.len();
         let mut dense = nalgebra::DMatrix::<f64>::zeros(n, n);
         for col in 0..n {
@@ -327,20 +326,7 @@ mod tests {
         let (solver, mut active, pairs) = at_impact();
         let fresh = |active: &[Active]| {
             let mut k = BlockMatrix::new(solver.model.blocks.len(), pairs.clone());
-            let (k0, _) = block_terms(&solver.params, &solver.model.blocks, 0.01);
-            k.diag.copy_from_slice(&k0);
-            for c in active {
-                if let Some(key) = c.stiffness_key() {
-                    apply_stiffness(
-                        &mut k,
-                        &solver.params.contact,
-                        &solver.model.blocks,
-                        c,
-                        &key,
-                        1.0,
-                    );
-                }
-            }
+            assemble_fresh(&solver, active, &mut k);
             k
         };
         let pattern = BlockMatrix::new(solver.model.blocks.len(), pairs.clone());
