@@ -72,7 +72,8 @@ impl Mode {
     }
 }
 
-/// Contact-law parameters (`[solver.contact]` in a scene file).
+/// Contact-law parameters (`[solver.contact]` in a scene file). The field docs name the symbol
+/// and say why a value is what it is; users' descriptions, ranges and defaults are in [`table`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ContactParams {
@@ -147,7 +148,7 @@ impl Default for ContactParams {
     }
 }
 
-/// Joint (interface) properties between blocks (`[joint]`).
+/// Joint (interface) properties between blocks (`[joint]`); see [`table`] for their ranges.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct JointParams {
