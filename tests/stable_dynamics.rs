@@ -1,0 +1,133 @@
+//! A stable block on a slope stays put in dynamic mode (issue #12): no creep. A family of
+//! blocks (slopes 10°–40°, factors of safety tan φ / tan θ from 1.1 to 3, downslope base over
+//! height 0.5–4, sizes 0.5–5 m) is run for 10 s in dynamic mode. Before a locked contact that
+//! had slid kept its friction, blocks of this family crept by up to 0.43 m between 1 s and 10 s
+//! (ALM) and 2.1 m (penalty).
+
+use std::path::Path;
+
+use dda3d::params::{Method, Mode};
+use dda3d::scene;
+use dda3d::solver::Solver;
+
+/// A block of `size` m downslope (and across), `size / aspect` m high, resting on a fixed slope of
+/// `theta` degrees with tan φ = `fos` · tan θ.
+fn slope_scene(theta: f64, fos: f64, aspect: f64, size: f64) -> String {
+    let (a, h) = (size, size / aspect);
+    let phi = (fos * theta.to_radians().tan()).atan().to_degrees();
+    let t = theta.to_radians();
+    let n = [t.sin(), 0.0, t.cos()];
+    let depth = a.max(h);
+    let (l, w) = (3.0 * a, 2.0 * a);
+    let c = |s: f64| format!("[{}, {}, {}]", n[0] * s, n[1] * s, n[2] * s);
+    format!(
+        r#"name = "stable block"
+[joint]
+friction_angle = {phi}
+[materials.rock]
+density = 2750.0
+young_modulus = 2.0e10
+poisson_ratio = 0.25
+[[blocks]]
+name = "slope"
+material = "rock"
+fixed = true
+box = {{ size = [{l}, {w}, {depth}], center = {}, rotation = [0, {theta}, 0] }}
+[[blocks]]
+name = "block"
+material = "rock"
+box = {{ size = [{a}, {a}, {h}], center = {}, rotation = [0, {theta}, 0] }}
+"#,
+        c(-depth / 2.0),
+        c(h / 2.0)
+    )
+}
+
+fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
+    ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
+}
+
+/// The block's centroid at t = 0, 1 s and `duration`.
+fn centroid_track(text: &str, method: Method, duration: f64) -> [[f64; 3]; 3] {
+    let mut s = scene::parse(text, "family.toml", "family").expect("scene parses");
+    s.params.method = method;
+    s.params.mode = Mode::Dynamic;
+    s.params.duration = duration;
+    let mut solver = Solver::new(s.model, s.params);
+    let centroid = |solver: &Solver| solver.snapshot().blocks[1].centroid;
+    let start = centroid(&solver);
+    while solver.time < 1.0 - 1e-9 {
+        solver.step_until(1.0).expect("runs");
+    }
+    let at_1s = centroid(&solver);
+    while !solver.finished() {
+        solver.step().expect("runs");
+    }
+    [start, at_1s, centroid(&solver)]
+}
+
+#[test]
+fn stable_blocks_do_not_creep_in_dynamic_mode() {
+    let mut worst = [(0.0, String::new()), (0.0, String::new())];
+    for theta in [10.0, 20.0, 30.0, 40.0] {
+        for fos in [1.1, 1.5, 3.0] {
+            for aspect in [0.5, 1.0, 2.0, 4.0] {
+                // Blocks whose base is too narrow topple; they are not in this family.
+                if aspect <= 1.2 * f64::tan(f64::to_radians(theta)) {
+                    continue;
+                }
+                for size in [0.5, 2.0, 5.0] {
+                    let text = slope_scene(theta, fos, aspect, size);
+                    for (k, method) in [Method::Alm, Method::Penalty].into_iter().enumerate() {
+                        let [_, at_1s, end] = centroid_track(&text, method, 10.0);
+                        let creep = distance(at_1s, end);
+                        if creep > worst[k].0 {
+                            let case = format!("θ {theta}°, F {fos}, a/h {aspect}, {size} m");
+                            worst[k] = (creep, case);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "largest creep from 1 s to 10 s: ALM {:.2e} m ({}), penalty {:.2e} m ({})",
+        worst[0].0, worst[0].1, worst[1].0, worst[1].1
+    );
+    assert!(
+        worst[0].0 < 1e-4,
+        "ALM creep {:.3e} m at {}",
+        worst[0].0,
+        worst[0].1
+    );
+}
+
+/// The paper's block (30°, φ = 35°, F = 1.21) in dynamic mode moves less than 0.1 mm in 10 s,
+/// from t = 0 (it moved 24 mm and was still going).
+#[test]
+fn the_paper_block_stays_put_in_dynamic_mode() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope_stable.toml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let [start, _, end] = centroid_track(&text, Method::Alm, 10.0);
+    let drift = distance(start, end);
+    assert!(drift < 1e-4, "drift {drift:.3e} m");
+}
+
+/// The control: the same block with F = 0.5 slides as theory says, so the test above is not
+/// passed by a block glued in place. (Closer to the friction limit the first steps still slide
+/// too far: F = 0.9 travels 3 % beyond theory in 2 s, before and after the friction fix; issue
+/// #12, item 4.)
+#[test]
+fn an_unstable_block_still_slides() {
+    for method in [Method::Alm, Method::Penalty] {
+        let [start, _, end] = centroid_track(&slope_scene(30.0, 0.5, 2.0, 2.0), method, 1.0);
+        // s = ½ g (sin θ − cos θ tan φ) t² = 1.225 m at t = 1 s (the block stays on the slope).
+        let t = 30f64.to_radians();
+        let want = 0.5 * 9.8 * (t.sin() - t.cos() * 0.5 * t.tan());
+        let got = distance(start, end);
+        assert!(
+            (got - want).abs() < 0.01 * want,
+            "{method:?}: slid {got:.4} m, theory {want:.4} m"
+        );
+    }
+}
