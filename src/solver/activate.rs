@@ -6,6 +6,7 @@ use std::collections::HashMap;
 
 use super::active::Active;
 use super::counters::debug_log;
+use super::step_control::max_step_penetration;
 use crate::contact::detection::{broad_phase, detect_pair};
 use crate::contact::kinematics::normal_kinematics;
 use crate::contact::record::ContactRecord;
@@ -163,7 +164,7 @@ fn keep_overlap(
     unseen: bool,
 ) {
     let p = inp.params;
-    let overlap_tol = p.contact.eps1 * (2.0 * p.max_displacement_ratio * inp.w0);
+    let overlap_tol = p.contact.eps1 * max_step_penetration(p, inp.w0);
     rec.overlap = (rec.overlap * (1.0 - OVERLAP_RELEASE)).min(d0.max(0.0));
     if unseen && *d0 > overlap_tol {
         rec.overlap = *d0;

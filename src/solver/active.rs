@@ -6,6 +6,7 @@ use crate::contact::law::{self, Settled};
 use crate::contact::record::ContactRecord;
 use crate::contact::{Candidate, ContactState};
 use crate::model::Block;
+use crate::params::{Method, SolverParams};
 use crate::physics::geometry::Vec3;
 use crate::physics::mechanics::{Mat3x12, Vec12, displacement_matrix};
 
@@ -99,6 +100,21 @@ impl Active {
         let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
         let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
         self.ta * di - self.tb(blocks) * dj
+    }
+
+    /// The friction of a sliding contact from the previous iterate's normal force (5.8):
+    /// λ_{k−1} tan φ (ALM), held once the slip has reversed (see the ALM loop), or p_n d_n tan φ
+    /// (penalty), N.
+    pub fn sliding_friction(&self, p: &SolverParams) -> f64 {
+        let n_prev = if p.method == Method::Alm {
+            self.rec
+                .lambda
+                .min(self.friction_cap.unwrap_or(f64::INFINITY))
+        } else {
+            self.rec.normal_force.max(0.0)
+        };
+        let tan_phi = p.joint.friction_angle.to_radians().tan();
+        n_prev * tan_phi
     }
 
     /// T_b at the contact's point of block j: the spring's reference point if locked.

@@ -85,18 +85,12 @@ pub(crate) fn alm_loop(
             hold_reversed_friction(inp, &d, active);
         }
         counters.assembly += watch.elapsed();
-        if conv1 && conv2 {
+        let converged = conv1 && conv2;
+        if converged || alm_k == cp.max_alm_iterations {
             return Ok(AlmOutcome {
                 d,
                 solves,
-                converged: true,
-            });
-        }
-        if alm_k == cp.max_alm_iterations {
-            return Ok(AlmOutcome {
-                d,
-                solves,
-                converged: false,
+                converged,
             });
         }
     }

@@ -128,16 +128,7 @@ pub(crate) fn contact_forces(p: &SolverParams, blocks: &[Block], c: &Active) -> 
             add_shear_spring_force(&mut t, &c.ta, &tb, &c.cand.normal, &delta, p_tau);
         }
         ContactState::Slide => {
-            // Friction from the previous iterate's normal force: λ_{k−1} (ALM), p_n d_n
-            // (penalty); held for the rest of the ALM loop once the slip has reversed (see
-            // the ALM loop).
-            let n_prev = if alm {
-                c.rec.lambda.min(c.friction_cap.unwrap_or(f64::INFINITY))
-            } else {
-                c.rec.normal_force.max(0.0)
-            };
-            let tan_phi = p.joint.friction_angle.to_radians().tan();
-            add_friction(&mut t, &c.ta, &tb, &c.rec.tau, n_prev * tan_phi);
+            add_friction(&mut t, &c.ta, &tb, &c.rec.tau, c.sliding_friction(p));
         }
         ContactState::Open => {}
     }

@@ -95,7 +95,7 @@ fn open_close_iteration(
             blocks: inp.blocks,
             k0: &k0,
             f0: &f0,
-            dn_max: 2.0 * p.max_displacement_ratio * inp.w0,
+            dn_max: step_control::max_step_penetration(p, inp.w0),
             slip_tolerance: law.slip_tolerance,
             settling: solved.settled,
         };

@@ -109,7 +109,7 @@ impl Solver {
 
     /// d_n,max = 2 δ w0 of (P22).
     pub fn max_step_penetration(&self) -> f64 {
-        2.0 * self.params.max_displacement_ratio * self.w0
+        step_control::max_step_penetration(&self.params, self.w0)
     }
 
     pub fn finished(&self) -> bool {
@@ -187,8 +187,9 @@ impl Solver {
         self.linear.pattern = pairs.clone();
         let kmat = BlockMatrix::new(self.model.blocks.len(), pairs);
         for c in &mut active {
+            let (i, j) = c.blocks();
             c.pair = kmat
-                .pair_index(c.cand.key.i as usize, c.cand.key.j as usize)
+                .pair_index(i, j)
                 .expect("pattern holds every contact pair");
         }
         (active, kmat)

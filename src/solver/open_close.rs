@@ -9,8 +9,8 @@ use super::step_control::Retry;
 use crate::contact::ContactState;
 use crate::contact::law::{self, LawParams, Observation, Transition};
 use crate::model::Block;
+use crate::params::SolverParams;
 use crate::params::step_rules::SETTLE_FRACTION;
-use crate::params::{Method, SolverParams};
 use crate::physics::geometry::Vec3;
 
 /// State changes a contact may make in one attempt before it is settled.
@@ -138,24 +138,13 @@ fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
             // stretched along τ so that p_τ·|Δ| equals that friction. A spring started at zero
             // dropped the shear the contact carried; the other contacts took it and slipped,
             // and a stable block ratcheted downhill step by step (issue #12).
-            let friction = sliding_friction(inp.params, c);
+            let friction = c.sliding_friction(inp.params);
             let p_tau = cp.shear_penalty(c.rec.penalty);
             c.rec.state = ContactState::Lock;
             c.rec.reference = c.cand.xb - c.rec.tau * (friction / p_tau);
         }
         Transition::Turn { tau } => c.rec.tau = tau,
     }
-}
-
-/// The friction a sliding contact applied in the last solve, N: λ tan φ (ALM; the held value if
-/// its slip reversed in the ALM loop) or N tan φ (penalty), as in the load vector.
-fn sliding_friction(p: &SolverParams, c: &Active) -> f64 {
-    let n = if p.method == Method::Alm {
-        c.rec.lambda.min(c.friction_cap.unwrap_or(f64::INFINITY))
-    } else {
-        c.rec.normal_force.max(0.0)
-    };
-    n * p.joint.friction_angle.to_radians().tan()
 }
 
 /// At the open–close pass limit: if more than [`SETTLE_FRACTION`] of the contacts still changed

@@ -61,6 +61,11 @@ impl Retry {
     }
 }
 
+/// d_n,max = 2 δ w0 of (P22): the largest penetration a step can make, m.
+pub(crate) fn max_step_penetration(p: &SolverParams, w0: f64) -> f64 {
+    2.0 * p.max_displacement_ratio * w0
+}
+
 /// The smallest step, Δt_max / [`DT_FLOOR_DIVISOR`]; a step that fails there diverges.
 pub(crate) fn dt_floor(p: &SolverParams) -> f64 {
     p.max_time_step / DT_FLOOR_DIVISOR
