@@ -10,6 +10,7 @@ use nalgebra::{Matrix6, Vector6};
 use crate::physics::geometry::{
     MassProperties, Topology, Vec3, bounding_box, mass_properties, newell_normal,
 };
+use crate::physics::integrator::Kinematics;
 use crate::physics::mechanics::{Mat12, Material, Vec12, elasticity_matrix, mass_matrix};
 
 /// One deformable block and its state carried between steps.
@@ -31,6 +32,9 @@ pub struct Block {
     pub elasticity: Matrix6<f64>,
     /// 12-vector of DOF rates carried between steps (§3.2).
     pub velocity: Vec12,
+    /// DOF accelerations of the last step (a dissipative step carries them; rock-mass
+    /// reference §4.3).
+    pub acceleration: Vec12,
     /// Accumulated stress [σx, σy, σz, τyz, τzx, τxy], Pa.
     pub stress: Vector6<f64>,
     pub strain: Vector6<f64>,
@@ -75,6 +79,7 @@ impl Block {
             mass_matrix: Mat12::zeros(),
             elasticity: elasticity_matrix(material.young_modulus, material.poisson_ratio),
             velocity: v,
+            acceleration: Vec12::zeros(),
             stress: Vector6::zeros(),
             strain: Vector6::zeros(),
             loads,
@@ -100,6 +105,19 @@ impl Block {
         let (lo, hi) = bounding_box(&self.vertices);
         self.lo = lo;
         self.hi = hi;
+    }
+
+    /// What the time integrator carries for this block.
+    pub fn kinematics(&self) -> Kinematics {
+        Kinematics {
+            velocity: self.velocity,
+            acceleration: self.acceleration,
+        }
+    }
+
+    pub fn set_kinematics(&mut self, k: Kinematics) {
+        self.velocity = k.velocity;
+        self.acceleration = k.acceleration;
     }
 
     /// ½ vᵀ M v.

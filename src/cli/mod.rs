@@ -62,6 +62,9 @@ pub struct SolverOverrides {
     /// Time integration: dynamic or static.
     #[arg(long, value_enum)]
     pub mode: Option<Mode>,
+    /// Numerical dissipation ρ∞ of the dynamic step, in [1/3, 1] (1: Shi's step).
+    #[arg(long)]
+    pub spectral_radius: Option<f64>,
     /// Simulated time, s.
     #[arg(long)]
     pub duration: Option<f64>,
@@ -104,6 +107,12 @@ pub fn load_scene(path: &Path, o: &SolverOverrides) -> Result<Scene, CliError> {
     }
     if let Some(m) = o.mode {
         s.params.mode = m;
+    }
+    if let Some(r) = o.spectral_radius {
+        s.params.spectral_radius = r;
+        s.params
+            .validate()
+            .map_err(|e| CliError::Input(format!("--spectral-radius: {e}")))?;
     }
     if let Some(d) = o.duration {
         if !(d.is_finite() && d > 0.0) {

@@ -177,6 +177,9 @@ impl Default for JointParams {
 pub struct SolverParams {
     pub method: Method,
     pub mode: Mode,
+    /// ρ∞ ∈ [⅓, 1]: the per-step amplification of modes with ωΔt → ∞ (Newmark γ = 1,
+    /// β = (1 + 3ρ∞)/(2(1 + ρ∞)²); 1 is Shi's step). See [`crate::physics::integrator`].
+    pub spectral_radius: f64,
     /// Simulated time to run, s.
     pub duration: f64,
     /// Δt_max, s.
@@ -208,6 +211,7 @@ impl Default for SolverParams {
         SolverParams {
             method: Method::Alm,
             mode: Mode::Dynamic,
+            spectral_radius: 0.5,
             duration: 2.0,
             max_time_step: 0.01,
             max_displacement_ratio: 0.01,

@@ -289,6 +289,22 @@ pub const MODE: Param = Param {
     widget: None,
 };
 
+pub const SPECTRAL_RADIUS: Param = Param {
+    key: "solver.spectral_radius",
+    label: "ρ∞",
+    unit: "",
+    doc: "Numerical dissipation of the dynamic step: the fraction of a mode far too stiff for Δt \
+          (contact and fixed-point springs) that survives one step.\n\
+          1 is Shi's step (3.2), which leaves those modes ringing: contact forces alternate step \
+          by step for as long as a run lasts. Lower values damp them (⅓ is the strongest); slow \
+          modes keep Shi's damping (Newmark γ = 1, β = (1 + 3ρ∞)/(2(1 + ρ∞)²)). Static mode \
+          ignores it.",
+    default: Value::Real(0.5),
+    get: |p| Value::Real(p.spectral_radius),
+    valid: Interval::new(Bound::Closed(1.0 / 3.0), Bound::Closed(1.0)),
+    widget: absolute(1.0 / 3.0, 1.0, false),
+};
+
 pub const DURATION: Param = Param {
     key: "solver.duration",
     label: "End time",
@@ -551,9 +567,10 @@ pub const COHESION: Param = Param {
 };
 
 /// Every key, in the scene file's order (`[solver]`, `[solver.contact]`, `[joint]`).
-pub const ALL: [&Param; 23] = [
+pub const ALL: [&Param; 24] = [
     &METHOD,
     &MODE,
+    &SPECTRAL_RADIUS,
     &DURATION,
     &MAX_TIME_STEP,
     &MAX_DISPLACEMENT_RATIO,

@@ -6,6 +6,7 @@
 use nalgebra::{Matrix6, SMatrix, SVector, Vector6};
 
 use crate::physics::geometry::{MassProperties, Mat3, Vec3};
+use crate::physics::integrator::{Kinematics, Scheme};
 
 pub type Mat12 = SMatrix<f64, 12, 12>;
 pub type Vec12 = SVector<f64, 12>;
@@ -150,7 +151,10 @@ pub struct BlockStepInput<'a> {
     pub density: f64,
     pub elasticity: &'a Matrix6<f64>,
     pub stress: &'a Vector6<f64>,
-    pub velocity: &'a Vec12,
+    /// Velocity, acceleration and residual carried from the last step.
+    pub kinematics: &'a Kinematics,
+    /// How the step integrates them (Shi's (3.2) or generalized-α).
+    pub scheme: &'a Scheme,
     pub gravity: &'a Vec3,
     /// Point loads: (current point, force).
     pub loads: &'a [(Vec3, Vec3)],
@@ -161,9 +165,9 @@ pub struct BlockStepInput<'a> {
 /// Assembles K_ii and F_i of (3.2)–(3.7).
 pub fn block_terms(b: &BlockStepInput, dt: f64) -> BlockTerms {
     let xc = b.mp.centroid;
-    // (3.2) inertia with constant acceleration over the step.
-    let mut k = b.mass_matrix * (2.0 / (dt * dt));
-    let mut f = b.mass_matrix * b.velocity * (2.0 / dt);
+    // (3.2) inertia with constant acceleration over the step, or its generalized-α form (R4.3).
+    let mut k = b.mass_matrix * b.scheme.mass_factor(dt);
+    let mut f = b.scheme.inertia_load(b.mass_matrix, b.kinematics, dt);
     // (3.3) elastic stiffness and (3.4) carried stress.
     let v = b.mp.volume;
     let mut kss = k.fixed_view_mut::<6, 6>(6, 6);
@@ -314,13 +318,18 @@ mod tests {
             (v[4], v[4], 4e12),
         ];
         let dt = 0.01;
+        let kinematics = Kinematics {
+            velocity: vel,
+            ..Kinematics::at_rest()
+        };
         let input = BlockStepInput {
             mass_matrix: &m,
             mp: &mp,
             density: rho,
             elasticity: &c,
             stress: &stress,
-            velocity: &vel,
+            kinematics: &kinematics,
+            scheme: &Scheme::SHI,
             gravity: &g,
             loads: &loads,
             springs: &springs,

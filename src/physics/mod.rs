@@ -6,8 +6,11 @@
 //! - [`mechanics`]: Shi's 12-DOF first-order displacement function and the block submatrices
 //!   (mass, elasticity, loads, fixed-point springs) of reference §1–3, and the finite-rotation
 //!   update (1.3);
+//! - [`integrator`]: the time step's inertia terms: Shi's step (3.2) and its dissipative
+//!   Newmark relatives (rock-mass reference §4);
 //! - [`linear`]: the block-sparse global matrix and its sparse Cholesky factorization.
 
 pub mod geometry;
+pub mod integrator;
 pub mod linear;
 pub mod mechanics;

@@ -11,8 +11,11 @@ use crate::contact::kinematics::{
 use crate::model::Block;
 use crate::params::{ContactParams, Method, SolverParams};
 use crate::physics::geometry::Vec3;
+use crate::physics::integrator::{Kinematics, Scheme};
 use crate::physics::linear::BlockMatrix;
-use crate::physics::mechanics::{BlockStepInput, Mat12, Vec12, block_terms as block_step_terms};
+use crate::physics::mechanics::{
+    BlockStepInput, BlockTerms, Mat12, Vec12, block_terms as block_step_terms,
+};
 
 /// The sparsity pattern of a step: block pairs with a contact now, plus pairs of the last
 /// pattern that are still `near` each other. Keeping those (as zero blocks) makes the pattern,
@@ -41,38 +44,58 @@ pub(crate) fn sparsity_pattern(
 
 /// (K0, F0): the block terms of §3 for a step of length `dt`, fixed for an attempt.
 pub(crate) fn block_terms(p: &SolverParams, blocks: &[Block], dt: f64) -> (Vec<Mat12>, Vec<Vec12>) {
-    let g = Vec3::from(p.gravity);
-    let mut k0 = Vec::with_capacity(blocks.len());
-    let mut f0 = Vec::with_capacity(blocks.len());
-    for b in blocks {
-        let springs: Vec<(Vec3, Vec3, f64)> = if b.fixed {
-            let k = p.fixed_spring_factor * b.material.young_modulus;
-            b.vertices
-                .iter()
-                .zip(&b.anchors)
-                .map(|(x, a)| (*x, *a, k))
-                .collect()
-        } else {
-            Vec::new()
-        };
-        let terms = block_step_terms(
-            &BlockStepInput {
-                mass_matrix: &b.mass_matrix,
-                mp: &b.mp,
-                density: b.density,
-                elasticity: &b.elasticity,
-                stress: &b.stress,
-                velocity: &b.velocity,
-                gravity: &g,
-                loads: &b.loads,
-                springs: &springs,
-            },
-            dt,
-        );
-        k0.push(terms.k);
-        f0.push(terms.f);
-    }
-    (k0, f0)
+    let scheme = super::scheme(p);
+    blocks
+        .iter()
+        .map(|b| {
+            let t = one_block(p, b, &scheme, &b.kinematics(), dt);
+            (t.k, t.f)
+        })
+        .unzip()
+}
+
+/// F of every block at D = 0 without inertia: gravity, loads, carried stress and fixed springs,
+/// the forces a block feels before any contact pushes back.
+pub(crate) fn static_loads(p: &SolverParams, blocks: &[Block]) -> Vec<Vec12> {
+    let rest = Kinematics::at_rest();
+    blocks
+        .iter()
+        .map(|b| one_block(p, b, &Scheme::SHI, &rest, p.max_time_step).f)
+        .collect()
+}
+
+fn one_block(
+    p: &SolverParams,
+    b: &Block,
+    scheme: &Scheme,
+    kin: &Kinematics,
+    dt: f64,
+) -> BlockTerms {
+    let springs: Vec<(Vec3, Vec3, f64)> = if b.fixed {
+        let k = p.fixed_spring_factor * b.material.young_modulus;
+        b.vertices
+            .iter()
+            .zip(&b.anchors)
+            .map(|(x, a)| (*x, *a, k))
+            .collect()
+    } else {
+        Vec::new()
+    };
+    block_step_terms(
+        &BlockStepInput {
+            mass_matrix: &b.mass_matrix,
+            mp: &b.mp,
+            density: b.density,
+            elasticity: &b.elasticity,
+            stress: &b.stress,
+            kinematics: kin,
+            scheme,
+            gravity: &Vec3::from(p.gravity),
+            loads: &b.loads,
+            springs: &springs,
+        },
+        dt,
+    )
 }
 
 /// The stiffness of one closed contact in the state `key`: normal (P10), and the shear spring

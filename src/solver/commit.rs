@@ -83,8 +83,8 @@ pub(crate) fn commit_contacts(
     (records, contacts)
 }
 
-/// Moves every block by its solution: velocity (3.2) v1 = 2D/Δt − v0, stress and strain, and the
-/// vertices and load points by the finite-rotation map (1.3).
+/// Moves every block by its solution: velocity (3.2) v1 = 2D/Δt − v0 or its generalized-α form
+/// (R4.4), stress and strain, and the vertices and load points by the finite-rotation map (1.3).
 pub(crate) fn commit_blocks(
     p: &SolverParams,
     blocks: &mut [Block],
@@ -92,9 +92,10 @@ pub(crate) fn commit_blocks(
     d: &[f64],
     dt: f64,
 ) {
+    let scheme = super::scheme(p);
     for (i, b) in blocks.iter_mut().enumerate() {
         let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
-        b.velocity = di * (2.0 / dt) - b.velocity;
+        b.set_kinematics(scheme.advance(&b.kinematics(), &di, dt));
         let de = di.fixed_rows::<6>(6).into_owned();
         let map = &maps[i];
         if p.rotate_stress {

@@ -33,8 +33,8 @@ use crate::contact::record::ContactRecord;
 use crate::model::Model;
 use crate::params::{Mode, SolverParams};
 use crate::physics::geometry::bounding_box;
+use crate::physics::integrator::{Kinematics, Scheme};
 use crate::physics::linear::{BlockMatrix, SparseCholesky};
-use crate::physics::mechanics::Vec12;
 use crate::snapshot::{BlockSnapshot, ContactSnapshot, RunTotals, Snapshot, StepStats};
 
 /// A run that cannot go on.
@@ -77,6 +77,25 @@ pub struct Solver {
     contact_sum: u64,
 }
 
+/// The time integrator of a step: static mode keeps Shi's form with v0 = 0 (reference §3.2,
+/// rock-mass reference §4.3), whose residual is exactly the inertia term (R5.1).
+pub(crate) fn scheme(p: &SolverParams) -> Scheme {
+    match p.mode {
+        Mode::Static => Scheme::SHI,
+        Mode::Dynamic => Scheme::with_spectral_radius(p.spectral_radius),
+    }
+}
+
+/// Consistent start values of every block (rock-mass reference §4.3): a0 = M⁻¹ F with F the
+/// static loads at D = 0 (no contact carries a force yet). Shi's step ignores a0; a dissipative
+/// step started from a0 = 0 would lag a falling block by Δt² g (β − ½) per step.
+fn start_consistently(params: &SolverParams, blocks: &mut [crate::model::Block]) {
+    let loads = assemble::static_loads(params, blocks);
+    for (b, f) in blocks.iter_mut().zip(loads) {
+        b.set_kinematics(Kinematics::consistent(&b.mass_matrix, b.velocity, &f));
+    }
+}
+
 impl Solver {
     pub fn new(model: Model, params: SolverParams) -> Self {
         let all: Vec<_> = model
@@ -86,6 +105,8 @@ impl Solver {
             .collect();
         let (lo, hi) = bounding_box(&all);
         let w0 = 0.5 * (hi - lo).max();
+        let mut model = model;
+        start_consistently(&params, &mut model.blocks);
         let last = commit::with_energy(StepStats::default(), &model.blocks, params.gravity);
         Solver {
             dt: params.max_time_step,
@@ -127,7 +148,7 @@ impl Solver {
         let watch = Stopwatch::start();
         if self.params.mode == Mode::Static {
             for b in &mut self.model.blocks {
-                b.velocity = Vec12::zeros();
+                b.set_kinematics(Kinematics::at_rest());
             }
         }
         let (mut active, mut kmat) = self.detect();

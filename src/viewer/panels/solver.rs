@@ -7,6 +7,7 @@ use egui::RichText;
 use super::widgets::{length, num, param_label, param_slider, seconds};
 use crate::params::table::{self, Value};
 use crate::params::{Method, Mode, SolverParams};
+use crate::physics::integrator::Scheme;
 use crate::viewer::state::UiState;
 
 /// The paper's p_n,1 = 0.01 E (§3.1), the "Paper defaults" button's initial penalty.
@@ -158,6 +159,23 @@ fn time_rows(ui: &mut egui::Ui, e: &mut SolverParams, model: &Model) {
     ui.label(RichText::new(seconds(e.max_time_step)).weak());
     ui.end_row();
 
+    let dynamic = e.mode == Mode::Dynamic;
+    ui.add_enabled_ui(dynamic, |ui| param_label(ui, &table::SPECTRAL_RADIUS));
+    ui.add_enabled(
+        dynamic,
+        param_slider(&mut e.spectral_radius, &table::SPECTRAL_RADIUS, young),
+    );
+    let scheme = if e.spectral_radius >= 1.0 {
+        "Shi's step".to_owned()
+    } else {
+        format!(
+            "β = {:.4}",
+            Scheme::with_spectral_radius(e.spectral_radius).beta
+        )
+    };
+    ui.label(RichText::new(scheme).weak());
+    ui.end_row();
+
     param_label(ui, &table::DURATION);
     ui.add(
         egui::DragValue::new(&mut e.duration)
@@ -214,6 +232,7 @@ fn presets(ui: &mut egui::Ui, state: &mut UiState) {
             *e = SolverParams {
                 method: keep.method,
                 mode: keep.mode,
+                spectral_radius: keep.spectral_radius,
                 duration: keep.duration,
                 gravity: keep.gravity,
                 joint: keep.joint.clone(),
@@ -252,7 +271,7 @@ fn paper_defaults_tip() -> String {
     .collect();
     format!(
         "Contact law and time stepping of the paper (Zhang Hong 2019, §3): p_n,1 = {} E, {}. \
-         Method, mode, joint and end time are kept.",
+         Method, mode, ρ∞, joint and end time are kept.",
         num(PAPER_PENALTY_PER_E),
         values.join(", ")
     )
