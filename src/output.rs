@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use serde::Serialize;
 
 use crate::snapshot::Snapshot;
-use crate::snapshot::{RunTotals, Timings};
+use crate::snapshot::{EquilibriumReport, RunTotals, Timings};
 
 /// Streams one row per block and one per active contact for every completed step.
 pub struct RunWriter {
@@ -156,6 +156,10 @@ pub struct Summary {
     pub frozen_contacts: u64,
     /// Seconds spent in each phase.
     pub timings: Timings,
+    /// The initial equilibrium stage (`[solver] initial_equilibrium`): its static steps, R_max
+    /// at its end, and whether R_max fell below the tolerance.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub equilibrium: Option<EquilibriumReport>,
 }
 
 impl Summary {
@@ -181,6 +185,7 @@ impl Summary {
             alm_cap_hits: t.alm_cap_hits,
             frozen_contacts: t.frozen_contacts,
             timings: t.timings.clone(),
+            equilibrium: None,
         }
     }
 

@@ -161,6 +161,23 @@ pub struct StepStats {
     pub elastic_energy: f64,
 }
 
+/// The initial equilibrium stage (`[solver] initial_equilibrium`), while it runs and after.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct EquilibriumReport {
+    /// Static steps taken.
+    pub steps: u64,
+    /// R_max after the last step: the largest unbalanced force of a free block over the forces
+    /// it carries (its weight plus its contact forces), or moment over those forces times its
+    /// radius (rock-mass reference (R5.1)).
+    pub residual: f64,
+    pub tolerance: f64,
+    /// R_max fell below the tolerance; otherwise the step limit ended the stage (a mechanism, or
+    /// too few steps for the model's softest mode).
+    pub converged: bool,
+    /// The stage is still under way (time stands at 0).
+    pub running: bool,
+}
+
 /// The state of a run at the end of a completed step (step 0 is the initial state).
 #[derive(Clone, Debug, Serialize)]
 pub struct Snapshot {
@@ -173,6 +190,8 @@ pub struct Snapshot {
     /// Closed contacts only.
     pub contacts: Vec<ContactSnapshot>,
     pub stats: StepStats,
+    /// The initial equilibrium stage, if the scene asked for one.
+    pub equilibrium: Option<EquilibriumReport>,
 }
 
 /// Wall time spent in the phases of the solver.

@@ -85,6 +85,7 @@ fn rockfall() -> Snapshot {
         blocks,
         contacts,
         stats: StepStats::default(),
+        equilibrium: None,
     }
 }
 

@@ -1,12 +1,12 @@
 //! A stable block on a slope stays put in dynamic mode (issue #12): no creep. A family of
 //! blocks (slopes 10°–40°, factors of safety tan φ / tan θ from 1.1 to 3, downslope base over
-//! height 0.5–4, sizes 0.5–5 m) is run for 10 s in dynamic mode. Before a locked contact that
-//! had slid kept its friction, blocks of this family crept by up to 0.43 m between 1 s and 10 s
-//! (ALM) and 2.1 m (penalty).
+//! height 0.5–4, sizes 0.5–5 m) is run for 10 s in dynamic mode, with and without the initial
+//! equilibrium stage. Before a locked contact that had slid kept its friction, blocks of this
+//! family crept by up to 0.43 m between 1 s and 10 s (ALM) and 2.1 m (penalty).
 
 use std::path::Path;
 
-use dda3d::params::{Method, Mode};
+use dda3d::params::{Method, Mode, SolverParams};
 use dda3d::scene;
 use dda3d::solver::Solver;
 
@@ -47,16 +47,27 @@ fn distance(a: [f64; 3], b: [f64; 3]) -> f64 {
     ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt()
 }
 
-/// The block's centroid at t = 0, 1 s and `duration`.
+/// The block's centroid at t = 0 (after the equilibrium stage, if any), 1 s and `duration`.
 fn centroid_track(text: &str, method: Method, duration: f64) -> [[f64; 3]; 3] {
+    track(text, duration, |p| p.method = method)
+}
+
+/// [`centroid_track`] with the scene's parameters changed by `set`.
+fn track(text: &str, duration: f64, set: impl Fn(&mut SolverParams)) -> [[f64; 3]; 3] {
     let mut s = scene::parse(text, "family.toml", "family").expect("scene parses");
-    s.params.method = method;
     s.params.mode = Mode::Dynamic;
     s.params.duration = duration;
+    set(&mut s.params);
     let mut solver = Solver::new(s.model, s.params);
+    while solver.in_equilibrium_stage() {
+        solver.step().expect("the stage runs");
+    }
+    if let Some(r) = solver.equilibrium().filter(|r| !r.converged) {
+        println!("stage not converged: {r:?}");
+    }
     let centroid = |solver: &Solver| solver.snapshot().blocks[1].centroid;
     let start = centroid(&solver);
-    while solver.time < 1.0 - 1e-9 {
+    while solver.time < 1.0f64.min(duration) - 1e-9 {
         solver.step_until(1.0).expect("runs");
     }
     let at_1s = centroid(&solver);
@@ -66,9 +77,31 @@ fn centroid_track(text: &str, method: Method, duration: f64) -> [[f64; 3]; 3] {
     [start, at_1s, centroid(&solver)]
 }
 
+/// The normal force at each upslope corner of a block of base `a` and height `h` on a slope of
+/// `theta` (P25), as a fraction of its weight: cos(θ + α) / (4 cos α) with tan α = h / a.
+fn upslope_corner_share(theta: f64, a: f64, h: f64) -> f64 {
+    let alpha = (h / a).atan();
+    (theta.to_radians() + alpha).cos() / (4.0 * alpha.cos())
+}
+
+/// The largest movement over the family, and the case it happened in.
+#[derive(Default)]
+struct Worst(f64, String);
+
+impl Worst {
+    fn update(&mut self, v: f64, case: &str) {
+        if v > self.0 {
+            *self = Worst(v, case.to_owned());
+        }
+    }
+}
+
 #[test]
 fn stable_blocks_do_not_creep_in_dynamic_mode() {
-    let mut worst = [(0.0, String::new()), (0.0, String::new())];
+    // [method][without, with the stage]: creep from 1 s to 10 s, and drift from t = 0.
+    let mut creep: [[Worst; 2]; 2] = Default::default();
+    let mut drift: [[Worst; 2]; 2] = Default::default();
+    let (mut cases, mut weak_corners) = (0, 0);
     for theta in [10.0, 20.0, 30.0, 40.0] {
         for fos in [1.1, 1.5, 3.0] {
             for aspect in [0.5, 1.0, 2.0, 4.0] {
@@ -78,32 +111,70 @@ fn stable_blocks_do_not_creep_in_dynamic_mode() {
                 }
                 for size in [0.5, 2.0, 5.0] {
                     let text = slope_scene(theta, fos, aspect, size);
+                    let case = format!("θ {theta}°, F {fos}, a/h {aspect}, {size} m");
+                    cases += 1;
+                    // An upslope corner alone could not hold its quarter of the downslope
+                    // weight: μ N_up < W sin θ / 4. The block stands because the downslope
+                    // corners carry more.
+                    let mu = fos * theta.to_radians().tan();
+                    let share = upslope_corner_share(theta, size, size / aspect);
+                    if mu * share < theta.to_radians().sin() / 4.0 {
+                        weak_corners += 1;
+                    }
                     for (k, method) in [Method::Alm, Method::Penalty].into_iter().enumerate() {
-                        let [_, at_1s, end] = centroid_track(&text, method, 10.0);
-                        let creep = distance(at_1s, end);
-                        if creep > worst[k].0 {
-                            let case = format!("θ {theta}°, F {fos}, a/h {aspect}, {size} m");
-                            worst[k] = (creep, case);
+                        for (e, stage) in [false, true].into_iter().enumerate() {
+                            let [start, at_1s, end] = track(&text, 10.0, |p| {
+                                p.method = method;
+                                p.initial_equilibrium = stage;
+                            });
+                            creep[k][e].update(distance(at_1s, end), &case);
+                            drift[k][e].update(distance(start, end), &case);
                         }
                     }
                 }
             }
         }
     }
-    println!(
-        "largest creep from 1 s to 10 s: ALM {:.2e} m ({}), penalty {:.2e} m ({})",
-        worst[0].0, worst[0].1, worst[1].0, worst[1].1
-    );
+    println!("{cases} blocks, {weak_corners} with upslope corners below their own friction limit");
+    for (k, method) in ["ALM", "penalty"].iter().enumerate() {
+        for (e, stage) in ["without", "with"].iter().enumerate() {
+            println!(
+                "{method}, {stage} the equilibrium stage: creep 1-10 s {:.2e} m ({}), drift 0-10 s {:.2e} m ({})",
+                creep[k][e].0, creep[k][e].1, drift[k][e].0, drift[k][e].1
+            );
+        }
+    }
+    assert!(cases >= 100 && weak_corners >= 10, "{cases} {weak_corners}");
+    let c = &creep[0][0];
     assert!(
-        worst[0].0 < 1e-4,
-        "ALM creep {:.3e} m at {}",
-        worst[0].0,
-        worst[0].1
+        c.0 < 1e-4,
+        "ALM without the stage: creep {:.3e} m at {}",
+        c.0,
+        c.1
+    );
+    // With the stage, three small blocks at F = 1.1 (0.5 m, a/h 2 and 4) still creep by up to
+    // 0.5 mm from 1 s to 10 s, and the issue's 0.1 mm is not met there (issue #12 stays open);
+    // this bound keeps them from getting worse. Every other block of the family, and the
+    // paper's block below, moves less than 0.1 mm.
+    let c = &creep[0][1];
+    assert!(
+        c.0 < 1e-3,
+        "ALM with the stage: creep {:.3e} m at {}",
+        c.0,
+        c.1
+    );
+    let d = &drift[0][1];
+    assert!(
+        d.0 < 1e-3,
+        "ALM after the stage: drift {:.3e} m at {}",
+        d.0,
+        d.1
     );
 }
 
 /// The paper's block (30°, φ = 35°, F = 1.21) in dynamic mode moves less than 0.1 mm in 10 s,
-/// from t = 0 (it moved 24 mm and was still going).
+/// from t = 0 (it moved 24 mm and was still going); after the equilibrium stage it does not
+/// move at all (1e-10 m).
 #[test]
 fn the_paper_block_stays_put_in_dynamic_mode() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope_stable.toml");
@@ -111,6 +182,17 @@ fn the_paper_block_stays_put_in_dynamic_mode() {
     let [start, _, end] = centroid_track(&text, Method::Alm, 10.0);
     let drift = distance(start, end);
     assert!(drift < 1e-4, "drift {drift:.3e} m");
+    for method in [Method::Alm, Method::Penalty] {
+        let [start, _, end] = track(&text, 10.0, |p| {
+            p.method = method;
+            p.initial_equilibrium = true;
+        });
+        let drift = distance(start, end);
+        assert!(
+            drift < 1e-6,
+            "{method:?} after the stage: drift {drift:.3e} m"
+        );
+    }
 }
 
 /// The control: the same block with F = 0.5 slides as theory says, so the test above is not

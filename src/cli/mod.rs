@@ -68,6 +68,10 @@ pub struct SolverOverrides {
     /// Simulated time, s.
     #[arg(long)]
     pub duration: Option<f64>,
+    /// Bring the model to rest under gravity before the run starts (the scene's
+    /// `initial_equilibrium = true`).
+    #[arg(long)]
+    pub initial_equilibrium: bool,
 }
 
 /// How a command failed, and with which exit status.
@@ -113,6 +117,9 @@ pub fn load_scene(path: &Path, o: &SolverOverrides) -> Result<Scene, CliError> {
         s.params
             .validate()
             .map_err(|e| CliError::Input(format!("--spectral-radius: {e}")))?;
+    }
+    if o.initial_equilibrium {
+        s.params.initial_equilibrium = true;
     }
     if let Some(d) = o.duration {
         if !(d.is_finite() && d > 0.0) {

@@ -1,7 +1,7 @@
 //! `dda3d run`: simulates a scene headless and writes blocks.csv, contacts.csv and summary.json,
 //! with a progress bar for long runs (also used by `dda3d render`).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use clap::Args;
@@ -70,6 +70,31 @@ impl Progress {
     }
 }
 
+/// Runs the initial equilibrium stage, if the scene has one, and says how it ended: an
+/// unconverged stage is a warning (a block the stage could not bring to rest), not an error.
+fn settle(solver: &mut Solver, scene: &Path, quiet: bool) -> Result<(), SolverError> {
+    while solver.in_equilibrium_stage() {
+        solver.step()?;
+    }
+    match solver.equilibrium() {
+        Some(r) if !r.converged => eprintln!(
+            "{}: warning: the initial equilibrium stage did not converge: R_max = {:.2e} after {} \
+             steps (tolerance {:.0e}); a block may be unstable under gravity, or raise \
+             equilibrium_max_steps",
+            scene.display(),
+            r.residual,
+            r.steps,
+            r.tolerance
+        ),
+        Some(r) if !quiet => eprintln!(
+            "initial equilibrium: R_max = {:.2e} after {} static steps",
+            r.residual, r.steps
+        ),
+        _ => {}
+    }
+    Ok(())
+}
+
 /// `dda3d run`.
 pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let scene = load_scene(&args.scene, &args.overrides)?;
@@ -84,9 +109,9 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
     let mut solver = Solver::new(scene.model, scene.params);
     let start = Instant::now();
     let mut progress = Progress::new(solver.params.duration, args.quiet);
+    let mut failure = settle(&mut solver, &args.scene, args.quiet).err();
     writer.write(&solver.snapshot()).map_err(io)?;
-    let mut failure: Option<SolverError> = None;
-    while !solver.finished() {
+    while failure.is_none() && !solver.finished() {
         if let Err(e) = solver.step() {
             failure = Some(e);
             break;
@@ -105,6 +130,7 @@ pub fn run(args: &RunArgs) -> Result<(), CliError> {
         wall,
         &solver.totals,
     );
+    summary.equilibrium = solver.equilibrium();
     if let Some(e) = &failure {
         summary.status = "diverged".into();
         summary.error = Some(e.to_string());

@@ -199,6 +199,13 @@ pub struct SolverParams {
     /// Rotate the carried stress with the block (objective update, reference §1.3). Classic DDA
     /// does not.
     pub rotate_stress: bool,
+    /// Bring the model to rest under gravity with static steps before the run starts
+    /// (rock-mass reference §5); see [`crate::solver`]'s equilibrium stage.
+    pub initial_equilibrium: bool,
+    /// The stage ends when R_max (R5.1) falls below this.
+    pub equilibrium_tolerance: f64,
+    /// The stage ends after this many static steps even if R_max has not fallen.
+    pub equilibrium_max_steps: u32,
     /// `[solver.contact]`.
     pub contact: ContactParams,
     /// The scene's top-level `[joint]` table (not part of `[solver]`).
@@ -219,6 +226,9 @@ impl Default for SolverParams {
             fixed_spring_factor: 100.0,
             max_displacement_overshoot: 1.0,
             rotate_stress: false,
+            initial_equilibrium: false,
+            equilibrium_tolerance: 1e-5,
+            equilibrium_max_steps: 2000,
             contact: ContactParams::default(),
             joint: JointParams::default(),
         }
@@ -319,9 +329,17 @@ mod tests {
         for p in ALL {
             let values: Vec<String> = match p.default {
                 Value::Real(_) => outside(p.valid).iter().map(|x| format!("{x:?}")).collect(),
-                Value::Count(_) => outside(p.valid)
+                // The whole number beyond the bound: below the lower one, above the upper one.
+                Value::Count(d) => outside(p.valid)
                     .iter()
-                    .map(|x| x.floor().to_string())
+                    .map(|x| {
+                        let whole = if *x < f64::from(d) {
+                            x.floor()
+                        } else {
+                            x.ceil()
+                        };
+                        whole.to_string()
+                    })
                     .collect(),
                 _ => continue,
             };

@@ -390,6 +390,47 @@ pub const ROTATE_STRESS: Param = Param {
     widget: None,
 };
 
+pub const INITIAL_EQUILIBRIUM: Param = Param {
+    key: "solver.initial_equilibrium",
+    label: "Initial equilibrium",
+    unit: "",
+    doc: "Before the run, bring the model to rest under gravity with static steps, then start at \
+          t = 0 with the contact forces in place and displacements measured from there (as \
+          3DEC's model solve before a dynamic stage). Without it gravity is switched on at t = 0 \
+          on unloaded contacts, a suddenly applied load that overshoots statics. Blocks with an \
+          initial velocity are held where they are during the stage.",
+    default: Value::Flag(false),
+    get: |p| Value::Flag(p.initial_equilibrium),
+    valid: Interval::ANY,
+    widget: None,
+};
+
+pub const EQUILIBRIUM_TOLERANCE: Param = Param {
+    key: "solver.equilibrium_tolerance",
+    label: "R_max",
+    unit: "",
+    doc: "The equilibrium stage ends when the largest unbalanced force of a block, over its \
+          weight plus its contact forces, falls below this (moments over those forces times the \
+          block's radius). 1e-5 is the usual equilibrium ratio of 3DEC and PFC.",
+    default: Value::Real(1e-5),
+    get: |p| Value::Real(p.equilibrium_tolerance),
+    valid: Interval::new(Bound::Open(0.0), Bound::Open(1.0)),
+    widget: None,
+};
+
+pub const EQUILIBRIUM_MAX_STEPS: Param = Param {
+    key: "solver.equilibrium_max_steps",
+    label: "Stage steps",
+    unit: "",
+    doc: "The equilibrium stage ends after this many static steps even if R_max is still above \
+          its tolerance (a mechanism: a block whose driving force exceeds its friction), and \
+          summary.json reports it unconverged.",
+    default: Value::Count(2000),
+    get: |p| Value::Count(p.equilibrium_max_steps),
+    valid: Interval::new(Bound::Closed(1.0), Bound::Closed(1e6)),
+    widget: None,
+};
+
 pub const INITIAL_PENALTY: Param = Param {
     key: "solver.contact.initial_penalty",
     label: "p_n,1",
@@ -567,7 +608,7 @@ pub const COHESION: Param = Param {
 };
 
 /// Every key, in the scene file's order (`[solver]`, `[solver.contact]`, `[joint]`).
-pub const ALL: [&Param; 24] = [
+pub const ALL: [&Param; 27] = [
     &METHOD,
     &MODE,
     &SPECTRAL_RADIUS,
@@ -578,6 +619,9 @@ pub const ALL: [&Param; 24] = [
     &FIXED_SPRING_FACTOR,
     &MAX_DISPLACEMENT_OVERSHOOT,
     &ROTATE_STRESS,
+    &INITIAL_EQUILIBRIUM,
+    &EQUILIBRIUM_TOLERANCE,
+    &EQUILIBRIUM_MAX_STEPS,
     &INITIAL_PENALTY,
     &ALPHA,
     &BETA,

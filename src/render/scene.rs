@@ -502,6 +502,7 @@ mod tests {
             ],
             contacts,
             stats: StepStats::default(),
+            equilibrium: None,
         }
     }
 

@@ -57,11 +57,12 @@ pub(crate) fn block_terms(p: &SolverParams, blocks: &[Block], dt: f64) -> (Vec<M
 /// F of every block at D = 0 without inertia: gravity, loads, carried stress and fixed springs,
 /// the forces a block feels before any contact pushes back.
 pub(crate) fn static_loads(p: &SolverParams, blocks: &[Block]) -> Vec<Vec12> {
-    let rest = Kinematics::at_rest();
-    blocks
-        .iter()
-        .map(|b| one_block(p, b, &Scheme::SHI, &rest, p.max_time_step).f)
-        .collect()
+    blocks.iter().map(|b| static_load(p, b)).collect()
+}
+
+/// [`static_loads`] of one block.
+pub(crate) fn static_load(p: &SolverParams, b: &Block) -> Vec12 {
+    one_block(p, b, &Scheme::SHI, &Kinematics::at_rest(), p.max_time_step).f
 }
 
 fn one_block(

@@ -18,6 +18,7 @@ mod assemble;
 mod attempt;
 mod commit;
 mod counters;
+mod equilibrium;
 mod open_close;
 mod step_control;
 
@@ -32,10 +33,13 @@ use crate::contact::ContactKey;
 use crate::contact::record::ContactRecord;
 use crate::model::Model;
 use crate::params::{Mode, SolverParams};
+use crate::physics::geometry::Vec3;
 use crate::physics::geometry::bounding_box;
 use crate::physics::integrator::{Kinematics, Scheme};
 use crate::physics::linear::{BlockMatrix, SparseCholesky};
-use crate::snapshot::{BlockSnapshot, ContactSnapshot, RunTotals, Snapshot, StepStats};
+use crate::snapshot::{
+    BlockSnapshot, ContactSnapshot, EquilibriumReport, RunTotals, Snapshot, StepStats,
+};
 
 /// A run that cannot go on.
 #[derive(Debug, Clone, thiserror::Error)]
@@ -75,6 +79,10 @@ pub struct Solver {
     pub totals: RunTotals,
     /// Contacts summed over all steps (for `contacts_per_step`).
     contact_sum: u64,
+    /// The initial equilibrium stage while it runs.
+    stage: Option<equilibrium::Stage>,
+    /// Its report once it is over.
+    equilibrium: Option<EquilibriumReport>,
 }
 
 /// The time integrator of a step: static mode keeps Shi's form with v0 = 0 (reference §3.2,
@@ -106,7 +114,12 @@ impl Solver {
         let (lo, hi) = bounding_box(&all);
         let w0 = 0.5 * (hi - lo).max();
         let mut model = model;
-        start_consistently(&params, &mut model.blocks);
+        let stage = params
+            .initial_equilibrium
+            .then(|| equilibrium::Stage::begin(&mut model.blocks, params.equilibrium_tolerance));
+        if stage.is_none() {
+            start_consistently(&params, &mut model.blocks);
+        }
         let last = commit::with_energy(StepStats::default(), &model.blocks, params.gravity);
         Solver {
             dt: params.max_time_step,
@@ -121,7 +134,19 @@ impl Solver {
             last,
             totals: RunTotals::default(),
             contact_sum: 0,
+            stage,
+            equilibrium: None,
         }
+    }
+
+    /// The initial equilibrium stage: under way, over, or `None` when the scene has none.
+    pub fn equilibrium(&self) -> Option<EquilibriumReport> {
+        self.stage.as_ref().map(|s| s.report).or(self.equilibrium)
+    }
+
+    /// Whether the initial equilibrium stage is still under way (time stands at 0).
+    pub fn in_equilibrium_stage(&self) -> bool {
+        self.stage.is_some()
     }
 
     pub fn w0(&self) -> f64 {
@@ -143,8 +168,115 @@ impl Solver {
     }
 
     /// Advances one step without passing `limit` (so that outputs land on requested times).
+    /// While the initial equilibrium stage runs, a step is one of its static steps instead.
     pub fn step_until(&mut self, limit: f64) -> Result<&StepStats, SolverError> {
+        if self.stage.is_some() {
+            return self.equilibrium_step();
+        }
         let limit = limit.min(self.params.duration);
+        let (dt, _) = self.advance(limit - self.time)?;
+        self.time += dt;
+        self.step += 1;
+        if debug_log() {
+            let l = &self.last;
+            eprintln!(
+                "step t={:.4} dt={dt:.2e} kinetic={:.4e} potential={:.6e} elastic={:.4e} passes={} factorizations={}",
+                self.time,
+                l.kinetic_energy,
+                l.potential_energy,
+                l.elastic_energy,
+                l.open_close_iterations,
+                l.factorizations
+            );
+        }
+        Ok(&self.last)
+    }
+
+    /// One step of the equilibrium stage: static with the joints held against sliding, then
+    /// dynamic with the real joints (see [`equilibrium`]). At its end the run starts at t = 0,
+    /// at rest, from the settled state.
+    fn equilibrium_step(&mut self) -> Result<&StepStats, SolverError> {
+        let locked = self.stage.as_ref().map(|s| s.phase) == Some(equilibrium::Phase::Locked);
+        let (stage_mode, stage_friction) = if locked {
+            let phi = equilibrium::STAGE_FRICTION_ANGLE.max(self.params.joint.friction_angle);
+            (Mode::Static, phi)
+        } else {
+            (Mode::Dynamic, self.params.joint.friction_angle)
+        };
+        let mode = std::mem::replace(&mut self.params.mode, stage_mode);
+        let friction = std::mem::replace(&mut self.params.joint.friction_angle, stage_friction);
+        let loads = self.point_loads_off();
+        let result = self.advance(f64::INFINITY);
+        self.restore_point_loads(loads);
+        self.params.mode = mode;
+        self.params.joint.friction_angle = friction;
+        let (dt, settled) = result?;
+        let stage = self.stage.as_mut().expect("the stage is under way");
+        let ratio = equilibrium::unbalanced_ratio(
+            &self.model.blocks,
+            dt,
+            &Vec3::from(self.params.gravity),
+            &self.contacts,
+            |i| !stage.is_held(i),
+        );
+        if debug_log() {
+            eprintln!(
+                "equilibrium step {} ({:?}) dt={dt:.2e} R_max={ratio:.3e}",
+                stage.report.steps + 1,
+                stage.phase
+            );
+        }
+        if stage.record(ratio, settled, self.params.equilibrium_max_steps) {
+            let stage = self.stage.take().expect("the stage is under way");
+            let params = &self.params;
+            self.equilibrium = Some(stage.finish(&mut self.model.blocks, |b| {
+                Kinematics::consistent(
+                    &b.mass_matrix,
+                    b.velocity,
+                    &assemble::static_load(params, b),
+                )
+            }));
+            self.time = 0.0;
+            self.step = 0;
+            self.totals = RunTotals::default();
+            self.contact_sum = 0;
+            self.dt = self.params.max_time_step;
+            self.last = commit::with_energy(
+                StepStats::default(),
+                &self.model.blocks,
+                self.params.gravity,
+            );
+        }
+        Ok(&self.last)
+    }
+
+    /// Sets every point load's force to zero (they act from t = 0, not in the stage); the
+    /// points keep moving with their blocks. Returns the forces.
+    fn point_loads_off(&mut self) -> Vec<Vec3> {
+        let mut forces = Vec::new();
+        for b in &mut self.model.blocks {
+            for (_, f) in &mut b.loads {
+                forces.push(std::mem::replace(f, Vec3::zeros()));
+            }
+        }
+        forces
+    }
+
+    /// Puts back the forces [`Self::point_loads_off`] took.
+    fn restore_point_loads(&mut self, forces: Vec<Vec3>) {
+        let slots = self
+            .model
+            .blocks
+            .iter_mut()
+            .flat_map(|b| b.loads.iter_mut());
+        for ((_, f), saved) in slots.zip(forces) {
+            *f = saved;
+        }
+    }
+
+    /// Detects, solves and commits one step of at most `room` seconds. Returns the step taken
+    /// and whether its open–close iteration was settled rather than converged.
+    fn advance(&mut self, room: f64) -> Result<(f64, bool), SolverError> {
         let watch = Stopwatch::start();
         if self.params.mode == Mode::Static {
             for b in &mut self.model.blocks {
@@ -156,7 +288,7 @@ impl Solver {
 
         let predicted = step_control::predict_dt(&self.params, &self.model.blocks, self.w0);
         let base = self.dt.min(predicted);
-        let first = step_control::first_attempt(base, limit - self.time);
+        let first = step_control::first_attempt(base, room);
         let (solved, dt, cuts, factorizations) = self.solve(&mut kmat, &mut active, first)?;
 
         let watch = Stopwatch::start();
@@ -165,8 +297,6 @@ impl Solver {
         self.records = records;
         self.contacts = contacts;
         commit::commit_blocks(&self.params, &mut self.model.blocks, &maps, &solved.d, dt);
-        self.time += dt;
-        self.step += 1;
         self.totals.timings.bookkeeping += watch.seconds();
 
         let stats = StepStats {
@@ -179,19 +309,8 @@ impl Solver {
         };
         self.count(&stats, active.len());
         self.last = commit::with_energy(stats, &self.model.blocks, self.params.gravity);
-        if debug_log() {
-            let l = &self.last;
-            eprintln!(
-                "step t={:.4} dt={dt:.2e} kinetic={:.4e} potential={:.6e} elastic={:.4e} passes={} factorizations={factorizations}",
-                self.time,
-                l.kinetic_energy,
-                l.potential_energy,
-                l.elastic_energy,
-                l.open_close_iterations
-            );
-        }
         self.dt = step_control::next_dt(&self.params, base, dt, cuts);
-        Ok(&self.last)
+        Ok((dt, solved.settled))
     }
 
     /// Stage 1: this step's contacts, and the global matrix laid out on their pattern.
@@ -309,6 +428,7 @@ impl Solver {
                 .collect(),
             contacts: self.contacts.clone(),
             stats: self.last.clone(),
+            equilibrium: self.equilibrium(),
         }
     }
 

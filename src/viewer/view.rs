@@ -227,6 +227,7 @@ mod tests {
             blocks,
             contacts: vec![],
             stats: StepStats::default(),
+            equilibrium: None,
         }
     }
 

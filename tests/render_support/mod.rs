@@ -158,6 +158,7 @@ pub fn slope_snapshot(t: f64, step: u64, s: f64, state: ContactState) -> Snapsho
         blocks: vec![slope, block],
         contacts,
         stats: StepStats::default(),
+        equilibrium: None,
     }
 }
 

@@ -60,6 +60,11 @@ fn method_and_mode(ui: &mut egui::Ui, e: &mut SolverParams) {
         ui.selectable_value(&mut e.mode, Mode::Dynamic, "Dynamic");
         ui.selectable_value(&mut e.mode, Mode::Static, "Static");
     });
+    ui.horizontal(|ui| {
+        param_label(ui, &table::INITIAL_EQUILIBRIUM);
+        ui.checkbox(&mut e.initial_equilibrium, "")
+            .on_hover_text("Takes effect at Reset: the run restarts with the stage.");
+    });
 }
 
 /// p_n,1, and the adaptive penalty of (P21): α, β, γ (ALM only).

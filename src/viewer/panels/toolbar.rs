@@ -4,7 +4,11 @@
 use egui::{Align, Color32, Layout, RichText};
 
 use super::widgets::{ERROR_RED, Icon, OK_GREEN, icon_button, num, seconds};
+use crate::params::table;
 use crate::render::overlay::format_time;
+
+/// The equilibrium stage's label: the run has not started yet.
+const STAGE_AMBER: Color32 = Color32::from_rgb(0xB0, 0x70, 0x10);
 use crate::viewer::sim::{Command, Frame, RunState, Speed};
 use crate::viewer::state::{Action, UiState};
 
@@ -111,6 +115,31 @@ fn progress(ui: &mut egui::Ui, frame: &Frame) {
     ui.label(RichText::new(format!("/ {}", format_time(frame.params.duration))).weak())
         .on_hover_text("End time: the run pauses here; Play continues past it");
     ui.label(format!("step {}", snap.step));
+    if let Some(r) = snap.equilibrium {
+        let text = if r.running {
+            RichText::new(format!(
+                "EQUILIBRIUM STAGE: static step {}, R_max {}",
+                r.steps,
+                num(r.residual)
+            ))
+            .strong()
+            .color(STAGE_AMBER)
+        } else {
+            RichText::new(format!("settled in {} steps", r.steps)).weak()
+        };
+        let tip = format!(
+            "{}\n\nR_max now {} (tolerance {}){}",
+            table::INITIAL_EQUILIBRIUM.doc(),
+            num(r.residual),
+            num(r.tolerance),
+            if r.running || r.converged {
+                ""
+            } else {
+                "; the stage reached its step limit without converging"
+            }
+        );
+        ui.label(text).on_hover_text(tip);
+    }
     ui.label(format!("Δt {}", seconds(snap.stats.time_step)))
         .on_hover_text("Length of the last accepted step");
     ui.label(format!("cuts {}", frame.totals.time_step_cuts))
