@@ -102,6 +102,8 @@ fn stable_blocks_do_not_creep_in_dynamic_mode() {
     let mut creep: [[Worst; 2]; 2] = Default::default();
     let mut drift: [[Worst; 2]; 2] = Default::default();
     let (mut cases, mut weak_corners) = (0, 0);
+    // Blocks that moved 0.1 mm or more from t = 0.
+    let mut moved = [[0usize; 2]; 2];
     for theta in [10.0, 20.0, 30.0, 40.0] {
         for fos in [1.1, 1.5, 3.0] {
             for aspect in [0.5, 1.0, 2.0, 4.0] {
@@ -129,6 +131,7 @@ fn stable_blocks_do_not_creep_in_dynamic_mode() {
                             });
                             creep[k][e].update(distance(at_1s, end), &case);
                             drift[k][e].update(distance(start, end), &case);
+                            moved[k][e] += usize::from(distance(start, end) >= 1e-4);
                         }
                     }
                 }
@@ -139,8 +142,8 @@ fn stable_blocks_do_not_creep_in_dynamic_mode() {
     for (k, method) in ["ALM", "penalty"].iter().enumerate() {
         for (e, stage) in ["without", "with"].iter().enumerate() {
             println!(
-                "{method}, {stage} the equilibrium stage: creep 1-10 s {:.2e} m ({}), drift 0-10 s {:.2e} m ({})",
-                creep[k][e].0, creep[k][e].1, drift[k][e].0, drift[k][e].1
+                "{method}, {stage} the equilibrium stage: creep 1-10 s {:.2e} m ({}), drift 0-10 s {:.2e} m ({}), {} blocks moved 0.1 mm or more",
+                creep[k][e].0, creep[k][e].1, drift[k][e].0, drift[k][e].1, moved[k][e]
             );
         }
     }
@@ -152,24 +155,15 @@ fn stable_blocks_do_not_creep_in_dynamic_mode() {
         c.0,
         c.1
     );
-    // With the stage, three small blocks at F = 1.1 (0.5 m, a/h 2 and 4) still creep by up to
-    // 0.5 mm from 1 s to 10 s, and the issue's 0.1 mm is not met there (issue #12 stays open);
-    // this bound keeps them from getting worse. Every other block of the family, and the
-    // paper's block below, moves less than 0.1 mm.
-    let c = &creep[0][1];
-    assert!(
-        c.0 < 1e-3,
-        "ALM with the stage: creep {:.3e} m at {}",
-        c.0,
-        c.1
-    );
+    // After the stage no ALM block moves by 0.1 mm, from t = 0.
     let d = &drift[0][1];
     assert!(
-        d.0 < 1e-3,
+        d.0 < 1e-4,
         "ALM after the stage: drift {:.3e} m at {}",
         d.0,
         d.1
     );
+    assert_eq!(moved[0][1], 0);
 }
 
 /// The paper's block (30°, φ = 35°, F = 1.21) in dynamic mode moves less than 0.1 mm in 10 s,
@@ -211,5 +205,164 @@ fn an_unstable_block_still_slides() {
             (got - want).abs() < 0.01 * want,
             "{method:?}: slid {got:.4} m, theory {want:.4} m"
         );
+    }
+}
+
+/// A flat block (`a` × `a` × `a`/8) on a slope of `theta` with φ = 20° and the cohesion that
+/// gives it a factor of safety `fos` = (W cos θ tan φ + c A) / (W sin θ).
+fn cohesive_scene(theta: f64, fos: f64, a: f64) -> String {
+    let (h, phi) = (a / 8.0, 20f64);
+    let t = theta.to_radians();
+    let weight = 2750.0 * a * a * h * 9.8;
+    let cohesion = (fos * weight * t.sin() - weight * t.cos() * phi.to_radians().tan()) / (a * a);
+    let friction_fos = phi.to_radians().tan() / t.tan();
+    let text = slope_scene(theta, friction_fos, 8.0, a).replace(
+        "[materials.rock]",
+        &format!("cohesion = {cohesion}\n[materials.rock]"),
+    );
+    assert!(text.contains("cohesion"));
+    text
+}
+
+/// A joint with a 10 % strength reserve from cohesion holds in dynamic mode after the
+/// equilibrium stage; with a 10 % shortfall the block slides. Without the stage, gravity
+/// switched on at t = 0 overshoots statics and breaks even the 10 % reserve (printed, not
+/// asserted: it is the behaviour the stage exists to avoid).
+#[test]
+fn cohesion_holds_with_a_reserve_and_fails_without() {
+    for theta in [25.0, 35.0] {
+        for a in [2.0, 4.0] {
+            let case = format!("θ {theta}°, {a} m");
+            let holds = cohesive_scene(theta, 1.1, a);
+            let stage = |p: &mut SolverParams| p.initial_equilibrium = true;
+            let [start, _, end] = track(&holds, 5.0, stage);
+            let drift = distance(start, end);
+            assert!(drift < 1e-4, "{case}, F 1.1: drift {drift:.3e} m");
+            let [start, _, end] = track(&cohesive_scene(theta, 0.9, a), 2.0, stage);
+            // Once the joint breaks, friction alone: s = ½ g (sin θ − cos θ tan φ) t².
+            let t = theta.to_radians();
+            let free = 0.5 * 9.8 * (t.sin() - t.cos() * 20f64.to_radians().tan()) * 4.0;
+            let slid = distance(start, end);
+            assert!(
+                slid > 0.5 * free,
+                "{case}, F 0.9: slid {slid:.3} m of {free:.3} m"
+            );
+            let [start, _, end] = track(&holds, 2.0, |_| {});
+            println!(
+                "{case}, F 1.1 without the stage: moved {:.3e} m in 2 s",
+                distance(start, end)
+            );
+        }
+    }
+}
+
+/// A block whose base over height is below tan θ topples (friction high enough that it cannot
+/// slide): the equilibrium stage must not hold it up, and the dissipation must not stop it.
+#[test]
+fn a_toppling_block_still_topples() {
+    for (aspect, size) in [(0.3, 1.0), (0.4, 1.0), (0.4, 3.0)] {
+        let text = slope_scene(30.0, 3.0, aspect, size);
+        let h = size / aspect;
+        for stage in [false, true] {
+            let [start, _, end] = track(&text, 3.0, |p| p.initial_equilibrium = stage);
+            let moved = distance(start, end);
+            assert!(
+                moved > 0.5 * h,
+                "a/h {aspect}, {size} m, stage {stage}: moved {moved:.3} m of h = {h} m"
+            );
+        }
+    }
+}
+
+/// A scene of one block of `size` (m) above a fixed base, its lowest point `drop` m above the
+/// base, rotated by `tilt` degrees about x then y.
+fn drop_scene(size: [f64; 3], drop: f64, tilt: [f64; 2]) -> String {
+    // The lowest vertex of the rotated box sits at its centre minus half its z extent.
+    let (ax, ay) = (tilt[0].to_radians(), tilt[1].to_radians());
+    let half = [size[0] / 2.0, size[1] / 2.0, size[2] / 2.0];
+    let mut low: f64 = 0.0;
+    for sx in [-1.0, 1.0] {
+        for sy in [-1.0, 1.0] {
+            for sz in [-1.0, 1.0] {
+                let (x, y, z) = (sx * half[0], sy * half[1], sz * half[2]);
+                // Rotation about x, then about y (the scene's order).
+                let (y1, z1) = (y * ax.cos() - z * ax.sin(), y * ax.sin() + z * ax.cos());
+                let z2 = -x * ay.sin() + z1 * ay.cos();
+                let _ = y1;
+                low = low.min(z2);
+            }
+        }
+    }
+    format!(
+        r#"name = "drop"
+[joint]
+friction_angle = 35.0
+[materials.rock]
+density = 2750.0
+young_modulus = 2.0e10
+poisson_ratio = 0.25
+[[blocks]]
+name = "base"
+material = "rock"
+fixed = true
+box = {{ size = [12, 12, 1], center = [0, 0, -0.5] }}
+[[blocks]]
+name = "block"
+material = "rock"
+box = {{ size = [{}, {}, {}], center = [0, 0, {}], rotation = [{}, {}, 0] }}
+"#,
+        size[0],
+        size[1],
+        size[2],
+        drop - low,
+        tilt[0],
+        tilt[1]
+    )
+}
+
+/// Blocks dropped or tipped onto a fixed base come to rest: within 5 s their kinetic energy
+/// falls below 1 % of its peak, with Shi's step (ρ∞ = 1) and the default dissipation.
+#[test]
+fn dropped_and_tipped_blocks_come_to_rest() {
+    let cases = [
+        ("cube dropped flat", drop_scene([1.0; 3], 0.2, [0.0, 0.0])),
+        (
+            "slab dropped on an edge",
+            drop_scene([2.0, 1.0, 0.5], 0.3, [0.0, 12.0]),
+        ),
+        (
+            "cube tipped on an edge",
+            drop_scene([1.0; 3], 0.0, [0.0, 20.0]),
+        ),
+        (
+            "cube dropped on a corner",
+            drop_scene([1.0; 3], 0.2, [15.0, 25.0]),
+        ),
+        (
+            "tall block tipped",
+            drop_scene([1.0, 1.0, 2.0], 0.0, [0.0, 10.0]),
+        ),
+    ];
+    for (what, text) in cases {
+        for rho in [1.0, 0.5] {
+            let mut s = scene::parse(&text, "drop.toml", "drop").expect("scene parses");
+            s.params.duration = 5.0;
+            s.params.spectral_radius = rho;
+            let mut solver = Solver::new(s.model, s.params);
+            let (mut peak, mut late) = (0.0f64, 0.0f64);
+            while !solver.finished() {
+                let k = solver.step().expect("runs").kinetic_energy;
+                peak = peak.max(k);
+                if solver.time > 4.0 {
+                    late = late.max(k);
+                }
+            }
+            println!("{what}, ρ∞ {rho}: kinetic energy peak {peak:.3e} J, after 4 s {late:.3e} J");
+            assert!(peak > 0.0, "{what}: it moves");
+            assert!(
+                late < 0.01 * peak,
+                "{what}, ρ∞ {rho}: {late:.3e} J of {peak:.3e} J"
+            );
+        }
     }
 }

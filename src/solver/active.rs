@@ -61,11 +61,17 @@ impl Active {
 
     /// Applies the settled state of [`law::settle`] to a contact whose open–close state does
     /// not converge.
-    pub fn settle(&mut self, close_tol: f64) {
+    pub fn settle(&mut self, close_tol: f64, p: &SolverParams) {
         match law::settle(self.rec.state, self.dn, close_tol) {
             Settled::Open => {
                 self.rec.state = ContactState::Open;
                 self.rec.lambda = 0.0;
+            }
+            // A sliding contact settled locked keeps its friction, as one that sticks does: a
+            // fresh spring dropped it, and a block whose corner sat at its friction limit,
+            // flipping between lock and slide until it was settled, crept 0.5 mm in 10 s.
+            Settled::Lock { fresh_spring: true } if self.rec.state == ContactState::Slide => {
+                self.stick(p);
             }
             Settled::Lock { fresh_spring: true } => {
                 self.rec.state = ContactState::Lock;
@@ -75,6 +81,17 @@ impl Active {
                 fresh_spring: false,
             } => {}
         }
+    }
+
+    /// Locks a sliding contact with the friction it had: its new shear spring starts stretched
+    /// along τ so that p_τ·|Δ| equals that friction. A spring started at zero dropped the shear
+    /// the contact carried; the other contacts took it and slipped, and a stable block ratcheted
+    /// downhill step by step (issue #12).
+    pub fn stick(&mut self, p: &SolverParams) {
+        let friction = self.sliding_friction(p);
+        let p_tau = p.contact.shear_penalty(self.rec.penalty);
+        self.rec.state = ContactState::Lock;
+        self.rec.reference = self.cand.xb - self.rec.tau * (friction / p_tau);
     }
 
     /// See [`StiffnessKey`].

@@ -11,7 +11,7 @@ use crate::contact::kinematics::{
 use crate::model::Block;
 use crate::params::{ContactParams, Method, SolverParams};
 use crate::physics::geometry::Vec3;
-use crate::physics::integrator::{Kinematics, Scheme};
+use crate::physics::integrator::Scheme;
 use crate::physics::linear::BlockMatrix;
 use crate::physics::mechanics::{
     BlockStepInput, BlockTerms, Mat12, Vec12, block_terms as block_step_terms,
@@ -43,33 +43,26 @@ pub(crate) fn sparsity_pattern(
 }
 
 /// (K0, F0): the block terms of §3 for a step of length `dt`, fixed for an attempt.
-pub(crate) fn block_terms(p: &SolverParams, blocks: &[Block], dt: f64) -> (Vec<Mat12>, Vec<Vec12>) {
-    let scheme = super::scheme(p);
+pub(crate) fn block_terms(
+    p: &SolverParams,
+    blocks: &[Block],
+    scheme: &Scheme,
+    dt: f64,
+) -> (Vec<Mat12>, Vec<Vec12>) {
     blocks
         .iter()
         .map(|b| {
-            let t = one_block(p, b, &scheme, &b.kinematics(), dt);
+            let t = one_block(p, b, scheme, &b.kinematics(), dt);
             (t.k, t.f)
         })
         .unzip()
-}
-
-/// F of every block at D = 0 without inertia: gravity, loads, carried stress and fixed springs,
-/// the forces a block feels before any contact pushes back.
-pub(crate) fn static_loads(p: &SolverParams, blocks: &[Block]) -> Vec<Vec12> {
-    blocks.iter().map(|b| static_load(p, b)).collect()
-}
-
-/// [`static_loads`] of one block.
-pub(crate) fn static_load(p: &SolverParams, b: &Block) -> Vec12 {
-    one_block(p, b, &Scheme::SHI, &Kinematics::at_rest(), p.max_time_step).f
 }
 
 fn one_block(
     p: &SolverParams,
     b: &Block,
     scheme: &Scheme,
-    kin: &Kinematics,
+    kin: &crate::physics::integrator::Kinematics,
     dt: f64,
 ) -> BlockTerms {
     let springs: Vec<(Vec3, Vec3, f64)> = if b.fixed {
@@ -261,7 +254,7 @@ mod tests {
 
     /// K assembled afresh for a step of 0.01 s: the block terms and every closed contact.
     fn assemble_fresh(solver: &Solver, active: &[Active], k: &mut BlockMatrix) {
-        let (k0, _) = block_terms(&solver.params, &solver.model.blocks, 0.01);
+        let (k0, _) = block_terms(&solver.params, &solver.model.blocks, &Scheme::SHI, 0.01);
         k.diag.copy_from_slice(&k0);
         for c in active {
             if let Some(key) = c.stiffness_key() {

@@ -11,6 +11,7 @@ use super::step_control::{self, Retry};
 use crate::contact::law::LawParams;
 use crate::model::Block;
 use crate::params::{Method, SolverParams};
+use crate::physics::integrator::Scheme;
 use crate::physics::linear::{BlockMatrix, SparseCholesky};
 
 /// What an attempt reads.
@@ -21,6 +22,8 @@ pub(crate) struct AttemptInputs<'a> {
     pub w0: f64,
     pub time: f64,
     pub dt: f64,
+    /// The time integrator of this step.
+    pub scheme: Scheme,
     /// The step is at the Δt floor: stragglers at the pass limit are settled, not redone.
     pub at_floor: bool,
 }
@@ -64,7 +67,7 @@ fn open_close_iteration(
     let cp = &p.contact;
     let watch = Stopwatch::start();
     // (K0, F0): the block terms of §3, fixed for the attempt.
-    let (k0, f0) = block_terms(p, inp.blocks, inp.dt);
+    let (k0, f0) = block_terms(p, inp.blocks, &inp.scheme, inp.dt);
     counters.assembly += watch.elapsed();
     let law = LawParams {
         close_penetration: cp.close_threshold * inp.w0,
@@ -86,7 +89,13 @@ fn open_close_iteration(
     };
     for pass in 0..=cp.max_open_close_iterations {
         if pass == cp.max_open_close_iterations {
-            open_close::settle_stragglers(active, law.close_penetration, inp.at_floor, counters)?;
+            open_close::settle_stragglers(
+                active,
+                p,
+                law.close_penetration,
+                inp.at_floor,
+                counters,
+            )?;
             solved.settled = true;
         }
         solved.oc_passes += 1;

@@ -10,6 +10,7 @@ use crate::contact::{ContactKey, ContactState};
 use crate::model::Block;
 use crate::params::{Method, SolverParams};
 use crate::physics::geometry::Vec3;
+use crate::physics::integrator::Scheme;
 use crate::physics::mechanics::{StepMap, Vec12, rotate_stress};
 use crate::snapshot::{ContactSnapshot, StepStats};
 
@@ -91,8 +92,8 @@ pub(crate) fn commit_blocks(
     maps: &[StepMap],
     d: &[f64],
     dt: f64,
+    scheme: &Scheme,
 ) {
-    let scheme = super::scheme(p);
     for (i, b) in blocks.iter_mut().enumerate() {
         let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
         b.set_kinematics(scheme.advance(&b.kinematics(), &di, dt));

@@ -63,7 +63,7 @@ pub(crate) fn check(
             // A contact that keeps cycling (typically an edge–edge and a vertex–face contact
             // of one block pair taking the load in turn) is settled for the rest of the
             // attempt (see `law::Settled`).
-            c.settle(inp.law.close_penetration);
+            c.settle(inp.law.close_penetration, inp.params);
             counters.totals.frozen_contacts += (before != c.rec.state) as u64;
             c.flips = 0;
             c.frozen = true;
@@ -133,16 +133,8 @@ fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
             c.rec.tau = tau;
             c.rec.intact = false;
         }
-        Transition::Stick => {
-            // The contact carries on with the friction it had: its new shear spring starts
-            // stretched along τ so that p_τ·|Δ| equals that friction. A spring started at zero
-            // dropped the shear the contact carried; the other contacts took it and slipped,
-            // and a stable block ratcheted downhill step by step (issue #12).
-            let friction = c.sliding_friction(inp.params);
-            let p_tau = cp.shear_penalty(c.rec.penalty);
-            c.rec.state = ContactState::Lock;
-            c.rec.reference = c.cand.xb - c.rec.tau * (friction / p_tau);
-        }
+        // The contact carries on with the friction it had (see [`Active::stick`]).
+        Transition::Stick => c.stick(inp.params),
         Transition::Turn { tau } => c.rec.tau = tau,
     }
 }
@@ -153,6 +145,7 @@ fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
 /// closed and locked for one more solve, and the step is accepted.
 pub(crate) fn settle_stragglers(
     active: &mut [Active],
+    params: &SolverParams,
     close_tol: f64,
     at_floor: bool,
     counters: &mut Counters,
@@ -162,7 +155,7 @@ pub(crate) fn settle_stragglers(
         return Err(Retry::OpenClose);
     }
     for c in active.iter_mut().filter(|c| c.changed) {
-        c.settle(close_tol);
+        c.settle(close_tol, params);
         counters.totals.frozen_contacts += 1;
     }
     Ok(())
