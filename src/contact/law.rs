@@ -11,8 +11,9 @@
 //! - a locked contact slides when its shear spring force exceeds N tan φ + c·A (Mohr–Coulomb;
 //!   cohesion only while the joint is intact), and only when the spring's shear displacement
 //!   exceeds f0·w0 (hysteresis for contacts that carry no load);
-//! - a sliding contact sticks again when its slip reverses or stops, or when the friction held
-//!   during the ALM loop stayed below its capacity λ tan φ (see [`Observation::held_friction`]);
+//! - a sliding contact sticks again when its slip reverses, or stops (if it was sliding when the
+//!   step began), or when the friction held during the ALM loop stayed below its capacity
+//!   λ tan φ (see [`Observation::held_friction`]);
 //!   otherwise its friction follows the slip direction.
 
 use super::ContactState;
@@ -55,6 +56,8 @@ pub struct Observation {
     pub tau: Vec3,
     /// λ, N.
     pub lambda: f64,
+    /// The contact was already sliding when the step began (not only since an earlier pass).
+    pub slid_before: bool,
     /// The multiplier at which a sliding contact's friction was held during the ALM loop,
     /// because its slip reversed there (see the solver's ALM loop); `None` if it was not.
     pub held_friction: Option<f64>,
@@ -107,10 +110,12 @@ pub fn classify(o: &Observation, p: &LawParams) -> Transition {
             let held_below = o
                 .held_friction
                 .is_some_and(|held| held < (1.0 - p.eps2) * o.lambda);
-            if reversed(&o.slip, &o.tau, p.slip_tolerance)
-                || o.slip.norm() < p.slip_tolerance
-                || held_below
-            {
+            // A stop counts only for a contact that was sliding when the step began. One that
+            // began to slide in an earlier pass of this step is held still in this pass by its
+            // neighbours' locked (stuck) contacts: sticking it then made the corners of a pushed
+            // block take turns, lock against slide, and the block stood for two steps.
+            let stopped = o.slid_before && o.slip.norm() < p.slip_tolerance;
+            if reversed(&o.slip, &o.tau, p.slip_tolerance) || stopped || held_below {
                 Transition::Stick
             } else if o.slip.norm() > p.slip_tolerance {
                 // Friction follows the slip direction; it has not reversed here, so friction
@@ -183,6 +188,7 @@ mod tests {
             tau: Vec3::x(),
             lambda: 1e4,
             held_friction: None,
+            slid_before: true,
         }
     }
 
@@ -281,6 +287,14 @@ mod tests {
         assert_eq!(classify(&o, &p), Transition::Stick, "reversed");
         o.slip = Vec3::new(0.0, 0.5e-6, 0.0);
         assert_eq!(classify(&o, &p), Transition::Stick, "stopped");
+        // One that began to slide in this step, held still in this pass, slides on.
+        o.slid_before = false;
+        assert_eq!(
+            classify(&o, &p),
+            Transition::Keep,
+            "held still by its neighbours"
+        );
+        o.slid_before = true;
         o.slip = Vec3::new(1e-3, 1e-3, 0.0);
         match classify(&o, &p) {
             Transition::Turn { tau } => {

@@ -102,6 +102,7 @@ fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
         tau: c.rec.tau,
         lambda: c.rec.lambda,
         held_friction: c.friction_cap,
+        slid_before: c.start.state == ContactState::Slide,
     };
     let verdict = law::classify(&seen, &inp.law);
     if c.rec.state == ContactState::Lock && verdict != Transition::Open {
