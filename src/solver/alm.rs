@@ -231,6 +231,12 @@ fn stick_slip(inp: &AlmInputs, d: &[f64], active: &[Active]) -> f64 {
 /// block pushed by 1.5 μmg travelled 0.6 % too far in 1 s, one at a factor of safety of 0.9 on
 /// 30° 3 % too far in 2 s, all of it gained in the first steps. The paper enforces only the
 /// normal constraint this way; its shear is a penalty spring.
+///
+/// The tolerance is the normal one. f0·w0 (the slip the contact law does not count, 1000 times
+/// smaller) was measured too: a 5 × 10 m block took up its load with 0.099 mm of slip instead
+/// of 0.12 mm and slides at F = 0.95 came within 0.05 % of theory instead of 0.35 %, but a
+/// struck wall of 100 blocks needed 158 solves a step instead of 99 (57 with no stick update)
+/// and ran 1.2 times slower again.
 fn absorb_stick_slip(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
     for c in active.iter_mut() {
         if c.rec.state == ContactState::Lock {

@@ -118,7 +118,7 @@ fn progress(ui: &mut egui::Ui, frame: &Frame) {
     if let Some(r) = snap.equilibrium {
         let text = if r.running {
             RichText::new(format!(
-                "EQUILIBRIUM STAGE: static step {}, R_max {}",
+                "EQUILIBRIUM STAGE: step {}, R_max {}",
                 r.steps,
                 num(r.residual)
             ))
