@@ -6,11 +6,14 @@
 //! compliance. After the stage the run starts at t = 0, at rest, with the contact forces (λ,
 //! penalties, shear springs) in place and the displacements measured from the settled state.
 //!
-//! The stage follows the usual recipe (rock-mass reference §5): static steps (v0 = 0 before
-//! every step, so no load is ever applied suddenly) with the joints held against sliding, as a
-//! very high friction would, until the model is at rest; then the run starts with the real
-//! joint properties. Contacts whose settled shear exceeds their Mohr–Coulomb capacity start to
-//! slide at the first step of the run. Cohesion is kept: no contact slides in the stage.
+//! The stage runs in two phases ([`Phase`]):
+//! 1. static steps (v0 = 0 before every step, so no load is ever applied suddenly) with the
+//!    joints held against sliding, as a very high friction would: the usual recipe (rock-mass
+//!    reference §5). Gravity loads the contacts and cohesion stays intact;
+//! 2. dynamic steps with the real joint properties, from that loaded state: contacts whose shear
+//!    exceeds their Mohr–Coulomb capacity slide and the load redistributes, until the model is at
+//!    rest again (or a block keeps sliding: a mechanism, and the stage ends unconverged).
+//!
 //! Two other designs were measured and rejected on the stable-block family of
 //! `tests/stable_dynamics.rs`: static steps with the real friction cycled corners at their
 //! friction limit (factor of safety 1.1) between lock and slide for hundreds of steps and left
@@ -21,10 +24,11 @@
 //! on the vertex springs of a fixed block, and start the run with their velocity. Point loads
 //! are not part of the stage: they act from t = 0.
 //!
-//! The stage's measure is the unbalanced force of (R5.1): a static step leaves exactly
-//! r = F − K D = (2/Δt²) M D = M a1. For each free block, its force part is compared with
-//! f_i = W_i + Σ|contact forces| and its moment part with f_i · L_i (L_i the block's radius);
-//! R_max is the largest ratio. 3DEC and PFC call a ratio of ~1e-5 equilibrium.
+//! The stage's measure is the unbalanced force: M a1 + M v1 / Δt, the force that would stop a
+//! block in one step (after a static step, twice (R5.1)'s r = F − K D = (2/Δt²) M D = M a1).
+//! For each free block, its force part is compared with f_i = W_i + Σ|contact forces| and its
+//! moment part with f_i · L_i (L_i the block's radius); R_max is the largest ratio. 3DEC and PFC
+//! call a ratio of ~1e-5 equilibrium.
 
 use crate::model::Block;
 use crate::physics::geometry::Vec3;
@@ -173,8 +177,8 @@ impl Stage {
 /// R_max after a step of length `dt`: the largest unbalanced force of a free block over the
 /// forces it carries, or moment over those forces times its radius. The unbalanced force is
 /// M a1 + M v1 / Δt: the force that would stop the block in one step. After a static step it is
-/// twice (R5.1)'s F − K D = M a1 (v1 = a1 Δt), which the halved tolerance of the locked phase
-/// does not need to correct for.
+/// twice (R5.1)'s F − K D = M a1 (v1 = a1 Δt); the locked phase reads it against the same
+/// tolerance, stricter by that factor of 2, which costs it a step or two.
 pub(crate) fn unbalanced_ratio(
     blocks: &[Block],
     dt: f64,
