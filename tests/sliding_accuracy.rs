@@ -86,9 +86,9 @@ fn slides_near_the_friction_limit_match_theory_from_the_first_step() {
                 let got = travel(&slope(theta, fos, a, h), Method::Alm, 2.0);
                 let err = (got - want).abs() / want;
                 let case = format!("θ {theta}°, F {fos}, {a} × {h} m");
-                // At F = 0.95 the net acceleration is 5 % of the driving one, and a tenth of a
-                // step's worth of it is 0.3 % of the travel.
-                let bound = if fos < 0.92 { 5e-4 } else { 5e-3 };
+                // At F = 0.95 the net acceleration is 5 % of the driving one, so an error in the
+                // driving force is 20 times larger in the travel.
+                let bound = if fos < 0.92 { 5e-4 } else { 1e-3 };
                 assert!(
                     err < bound,
                     "{case}: travelled {got:.5} m, theory {want:.5} m"

@@ -24,6 +24,8 @@ pub(crate) struct AttemptInputs<'a> {
     pub dt: f64,
     /// The time integrator of this step.
     pub scheme: Scheme,
+    /// The first step of the run (or after the equilibrium stage).
+    pub first_step: bool,
     /// The step is at the Δt floor: stragglers at the pass limit are settled, not redone.
     pub at_floor: bool,
 }
@@ -106,6 +108,11 @@ fn open_close_iteration(
             f0: &f0,
             dn_max: step_control::max_step_penetration(p, inp.w0),
             slip_tolerance: law.slip_tolerance,
+            stick_tolerance: if inp.first_step {
+                law.slip_tolerance
+            } else {
+                cp.eps1 * step_control::max_step_penetration(p, inp.w0)
+            },
             settling: solved.settled,
         };
         let mut sys = System {

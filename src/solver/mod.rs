@@ -358,6 +358,7 @@ impl Solver {
                 time: self.time,
                 dt,
                 scheme,
+                first_step: self.step == 0,
                 at_floor,
             };
             match attempt(&inputs, kmat, &mut self.linear.chol, active, &mut counters) {
