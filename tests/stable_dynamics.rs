@@ -299,9 +299,8 @@ fn drop_scene(size: [f64; 3], drop: f64, tilt: [f64; 2]) -> String {
             for sz in [-1.0, 1.0] {
                 let (x, y, z) = (sx * half[0], sy * half[1], sz * half[2]);
                 // Rotation about x, then about y (the scene's order).
-                let (y1, z1) = (y * ax.cos() - z * ax.sin(), y * ax.sin() + z * ax.cos());
+                let z1 = y * ax.sin() + z * ax.cos();
                 let z2 = -x * ay.sin() + z1 * ay.cos();
-                let _ = y1;
                 low = low.min(z2);
             }
         }
