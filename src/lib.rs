@@ -30,4 +30,5 @@ pub mod render;
 pub mod scene;
 pub mod snapshot;
 pub mod solver;
+pub mod text;
 pub mod viewer;

@@ -1,0 +1,64 @@
+//! How numbers are written in messages: short, whatever their size. `1e308` prints as `1e308`,
+//! not as 309 digits, and a ratio of 10³⁰⁰ as `1e300`; ordinary values keep their plain form.
+
+/// Significant digits kept in a message.
+const DIGITS: usize = 4;
+
+/// `x` in at most [`DIGITS`] significant digits: plain between 1e-3 and 1e6, scientific
+/// (`2.5e-15`, `1e308`) outside, with trailing zeros dropped. Infinities and NaN print as
+/// `inf`, `-inf` and `NaN`.
+pub fn short(x: f64) -> String {
+    if !x.is_finite() {
+        return format!("{x}");
+    }
+    if x == 0.0 {
+        return "0".to_string();
+    }
+    // Rounded to DIGITS significant digits first, so that 999 999.9 is 1e6 and 0.00099999
+    // is 0.001.
+    let sci = format!("{x:.*e}", DIGITS - 1);
+    let rounded: f64 = sci.parse().unwrap_or(x);
+    if (1e-3..1e6).contains(&rounded.abs()) {
+        let decimals = (DIGITS as i32 - 1 - rounded.abs().log10().floor() as i32).max(0);
+        return trim(&format!("{rounded:.*}", decimals as usize));
+    }
+    let (mantissa, exponent) = sci.split_once('e').unwrap_or((&sci, "0"));
+    format!("{}e{exponent}", trim(mantissa))
+}
+
+/// Drops trailing zeros after a decimal point, and the point itself if nothing follows it.
+fn trim(s: &str) -> String {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::short;
+
+    #[test]
+    fn numbers_print_short_whatever_their_size() {
+        assert_eq!(short(1e308), "1e308");
+        assert_eq!(short(-1e300), "-1e300");
+        assert_eq!(short(1e-15), "1e-15");
+        assert_eq!(short(2.5e-300), "2.5e-300");
+        assert_eq!(short(0.01), "0.01");
+        assert_eq!(short(2.0), "2");
+        assert_eq!(short(-1.0), "-1");
+        assert_eq!(short(0.0), "0");
+        assert_eq!(short(123.456789), "123.5");
+        assert_eq!(short(999_999.9), "1e6");
+        assert_eq!(short(1.23456e9), "1.235e9");
+        assert_eq!(short(0.000_999_99), "0.001");
+        assert_eq!(short(f64::INFINITY), "inf");
+        assert_eq!(short(f64::NAN), "NaN");
+        // Every output parses back to within the kept digits.
+        for &x in &[3.3e-7, 7.77e12, 0.123_456, 4.2e5, 1.0e6, 9.9996e-4] {
+            let back: f64 = short(x).parse().unwrap();
+            assert!((back - x).abs() <= 1e-3 * x.abs(), "{x} -> {}", short(x));
+        }
+    }
+}
