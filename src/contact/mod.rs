@@ -10,6 +10,7 @@
 //! and what it finds ([`Candidate`]).
 
 pub mod detection;
+pub mod groups;
 pub mod kinematics;
 pub mod law;
 pub mod record;
@@ -77,7 +78,7 @@ pub struct DetectionParams {
 impl DetectionParams {
     /// Shi's control lengths for a model of half-extent `w0` and displacement ratio δ.
     pub fn new(w0: f64, delta: f64) -> Self {
-        let ds = 2.5 * delta * w0;
+        let ds = groups::search_distance(w0, delta);
         let sin3 = 3f64.to_radians().sin();
         DetectionParams {
             search_distance: ds,

@@ -7,7 +7,8 @@ use std::collections::HashMap;
 use super::active::Active;
 use super::counters::debug_log;
 use super::step_control::max_step_penetration;
-use crate::contact::detection::{broad_phase, detect_pair};
+use crate::contact::detection::detect_pair;
+use crate::contact::groups::{Bounds, ContactGroups};
 use crate::contact::kinematics::normal_kinematics;
 use crate::contact::record::ContactRecord;
 use crate::contact::{Candidate, ContactKey, ContactState, DetectionParams, Shape};
@@ -24,22 +25,29 @@ pub(crate) struct ActivationInputs<'a> {
     pub params: &'a SolverParams,
     pub blocks: &'a [Block],
     pub records: &'a HashMap<ContactKey, ContactRecord>,
-    /// Shi's w0, m.
-    pub w0: f64,
+    /// Each block's initial bounding box (its group's w0 is measured on those).
+    pub initial_boxes: &'a [(Vec3, Vec3)],
     /// The step about to be taken (0 for the first) and its start time.
     pub step: u64,
     pub time: f64,
 }
 
-/// This step's contacts, and the block pairs near each other (the broad phase's pairs, sorted).
-pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, Vec<(usize, usize)>) {
+/// This step's contacts, and the contact groups with their w0 and the block pairs near each
+/// other (the broad phase's pairs, sorted).
+pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let p = inp.params;
-    let dp = DetectionParams::new(inp.w0, p.max_displacement_ratio);
     let shapes: Vec<Shape> = inp.blocks.iter().map(Shape::of).collect();
-    let near = broad_phase(&shapes, dp.search_distance);
+    let bounds = inp
+        .blocks
+        .iter()
+        .zip(inp.initial_boxes)
+        .map(|(b, &home)| Bounds::of(b, home))
+        .collect();
+    let groups = ContactGroups::find(bounds, p.max_displacement_ratio);
     let known = |k: &ContactKey| inp.records.contains_key(k);
     let mut cands: Vec<Candidate> = Vec::new();
-    for &(a, b) in &near {
+    for &(a, b) in &groups.pairs {
+        let dp = DetectionParams::new(groups.w0_of(a), p.max_displacement_ratio);
         cands.extend(detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known));
     }
     // Contact transfer: a vertex that slid onto an adjacent, almost coplanar face of the same
@@ -52,19 +60,23 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, Vec<(usize, usiz
     }
     let mut active: Vec<Active> = cands
         .into_iter()
-        .map(|cand| activate_one(inp, &by_vertex, cand))
+        .map(|cand| {
+            let w0 = groups.w0_of(cand.key.i as usize);
+            activate_one(inp, &by_vertex, cand, w0)
+        })
         .collect();
     if inp.step == 0 && p.joint.cohesion > 0.0 {
         assign_cohesion_areas(&mut active);
     }
-    (active, near)
+    (active, groups)
 }
 
-/// One detected contact with its record and frozen kinematics.
+/// One detected contact with its record and frozen kinematics; `w0` is its group's.
 fn activate_one(
     inp: &ActivationInputs,
     by_vertex: &HashMap<(u32, u32, u32), ContactKey>,
     cand: Candidate,
+    w0: f64,
 ) -> Active {
     let p = inp.params;
     let blocks = inp.blocks;
@@ -96,18 +108,19 @@ fn activate_one(
             r.normal = cand.normal;
             r
         }
-        None => new_record(inp, &cand),
+        None => new_record(inp, &cand, w0),
     };
     if p.method == Method::Penalty {
         rec.penalty = p.contact.initial_penalty;
     }
     let unseen = old.is_none_or(|r| r.state == ContactState::Open);
-    keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen);
+    keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen, w0);
     let ta = displacement_matrix(&(cand.xa - bi.mp.centroid));
     Active {
         kin,
         ta,
         young: bi.material.young_modulus.min(bj.material.young_modulus),
+        w0,
         start: rec,
         rec,
         cand,
@@ -126,9 +139,9 @@ fn activate_one(
 
 /// The record of a contact seen for the first time: closed (locked) if it is touching or
 /// overlapping, open across a gap. Only contacts closed at t = 0 are intact (have cohesion).
-fn new_record(inp: &ActivationInputs, cand: &Candidate) -> ContactRecord {
+fn new_record(inp: &ActivationInputs, cand: &Candidate, w0: f64) -> ContactRecord {
     let p = inp.params;
-    let close_tol = p.contact.close_threshold * inp.w0;
+    let close_tol = p.contact.close_threshold * w0;
     let touching = -cand.gap > -close_tol;
     ContactRecord {
         state: if touching {
@@ -162,9 +175,10 @@ fn keep_overlap(
     rec: &mut ContactRecord,
     d0: &mut f64,
     unseen: bool,
+    w0: f64,
 ) {
     let p = inp.params;
-    let overlap_tol = p.contact.eps1 * max_step_penetration(p, inp.w0);
+    let overlap_tol = p.contact.eps1 * max_step_penetration(p, w0);
     rec.overlap = (rec.overlap * (1.0 - OVERLAP_RELEASE)).min(d0.max(0.0));
     if unseen && *d0 > overlap_tol {
         rec.overlap = *d0;

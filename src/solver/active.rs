@@ -2,7 +2,8 @@
 //! and the working values of the iterations (d_n, N, the flips of the open–close check).
 
 use crate::contact::kinematics::NormalKinematics;
-use crate::contact::law::{self, Settled};
+use super::step_control::max_step_penetration;
+use crate::contact::law::{self, LawParams, Settled};
 use crate::contact::record::ContactRecord;
 use crate::contact::{Candidate, ContactState};
 use crate::model::Block;
@@ -23,6 +24,9 @@ pub(crate) struct Active {
     pub pair: usize,
     /// The smaller Young's modulus of the two blocks: the cap γE of (P21b).
     pub young: f64,
+    /// Shi's w0 of the contact's group (`crate::contact::groups`), m: the length its
+    /// thresholds and tolerances scale with.
+    pub w0: f64,
     /// d_n after the last solve (5.4), m.
     pub dn: f64,
     /// N after the last solve (5.6), N.
@@ -59,9 +63,42 @@ impl Active {
         (self.cand.key.i as usize, self.cand.key.j as usize)
     }
 
+    /// The contact law's thresholds at this contact's w0.
+    pub fn law(&self, p: &SolverParams) -> LawParams {
+        let cp = &p.contact;
+        LawParams {
+            close_penetration: cp.close_threshold * self.w0,
+            open_tension: cp.initial_penalty * (cp.open_threshold * self.w0),
+            slip_tolerance: cp.open_threshold * self.w0,
+            tan_phi: p.joint.friction_angle.to_radians().tan(),
+            eps2: cp.eps2,
+        }
+    }
+
+    /// d_n,max = 2 δ w0 of (P22) at this contact's w0, m.
+    pub fn dn_max(&self, p: &SolverParams) -> f64 {
+        max_step_penetration(p, self.w0)
+    }
+
+    /// f0·w0: slip below this is not a reversal, m.
+    pub fn slip_tolerance(&self, p: &SolverParams) -> f64 {
+        p.contact.open_threshold * self.w0
+    }
+
+    /// A locked contact is stuck when its slip in a solve is below this, m: ε1·d_n,max, or
+    /// f0·w0 in the first step of a run (see `alm::absorb_stick_slip`).
+    pub fn stick_tolerance(&self, p: &SolverParams, first_step: bool) -> f64 {
+        if first_step {
+            self.slip_tolerance(p)
+        } else {
+            p.contact.eps1 * self.dn_max(p)
+        }
+    }
+
     /// Applies the settled state of [`law::settle`] to a contact whose open–close state does
     /// not converge.
-    pub fn settle(&mut self, close_tol: f64, p: &SolverParams) {
+    pub fn settle(&mut self, p: &SolverParams) {
+        let close_tol = p.contact.close_threshold * self.w0;
         match law::settle(self.rec.state, self.dn, close_tol) {
             Settled::Open => {
                 self.rec.state = ContactState::Open;

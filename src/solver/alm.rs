@@ -9,7 +9,7 @@ use super::counters::{Counters, Stopwatch};
 use super::step_control::Retry;
 use crate::contact::{ContactState, law};
 use crate::model::Block;
-use crate::params::{ContactParams, Method, SolverParams};
+use crate::params::{Method, SolverParams};
 use crate::physics::linear::{BlockMatrix, SparseCholesky};
 use crate::physics::mechanics::{Mat12, Vec12};
 
@@ -27,12 +27,9 @@ pub(crate) struct AlmInputs<'a> {
     /// K0 and F0 of the attempt.
     pub k0: &'a [Mat12],
     pub f0: &'a [Vec12],
-    /// d_n,max = 2 δ w0 of (P22), m.
-    pub dn_max: f64,
-    /// f0·w0: slip below this is not a reversal, m.
-    pub slip_tolerance: f64,
-    /// A locked contact is stuck when its slip in a solve is below this, m.
-    pub stick_tolerance: f64,
+    /// The first step of the run: locked contacts are stuck at a looser tolerance
+    /// ([`Active::stick_tolerance`]).
+    pub first_step: bool,
     /// The last pass of a non-converging open–close iteration: no more friction holds.
     pub settling: bool,
 }
@@ -72,7 +69,7 @@ pub(crate) fn alm_loop(
         let solves = alm_k;
         let d = solve(inp, sys, active, counters, k_dirty)?;
         let watch = Stopwatch::start();
-        let (conv1, conv2) = measure(p, inp.dn_max, &d, active);
+        let (conv1, conv2) = measure(p, &d, active);
         if p.method == Method::Penalty {
             counters.assembly += watch.elapsed();
             return Ok(AlmOutcome {
@@ -81,10 +78,10 @@ pub(crate) fn alm_loop(
                 converged: true,
             });
         }
-        let stuck = stick_slip(inp, &d, active) <= inp.stick_tolerance;
+        let stuck = stuck(inp, &d, active);
         let converged = conv1 && conv2 && stuck;
         // K changes only where (P21) raised a penalty.
-        k_dirty = update_multipliers(cp, inp.dn_max, alm_k, converged, active);
+        k_dirty = update_multipliers(p, alm_k, converged, active);
         if !converged && alm_k < cp.max_alm_iterations {
             absorb_stick_slip(inp, &d, active);
         }
@@ -137,9 +134,10 @@ fn solve(
 }
 
 /// d_n and N of every contact (5.4), (5.6) for the solution `d`, and the convergence tests
-/// (P23) and (P24); an unchanged zero force vector counts as converged.
-fn measure(p: &SolverParams, dn_max: f64, d: &[f64], active: &mut [Active]) -> (bool, bool) {
-    let mut max_dn: f64 = 0.0;
+/// (P23), each contact against its own group's d_n,max, and (P24); an unchanged zero force
+/// vector counts as converged.
+fn measure(p: &SolverParams, d: &[f64], active: &mut [Active]) -> (bool, bool) {
+    let mut conv1 = true;
     let (mut dl2, mut l2) = (0.0, 0.0);
     for c in active.iter_mut() {
         let (i, j) = c.blocks();
@@ -155,14 +153,13 @@ fn measure(p: &SolverParams, dn_max: f64, d: &[f64], active: &mut [Active]) -> (
             0.0
         };
         c.force = lambda + c.rec.penalty * c.dn;
-        max_dn = max_dn.max(c.dn.abs());
+        conv1 &= c.dn.abs() <= p.contact.eps1 * c.dn_max(p);
         if p.method == Method::Alm {
             let new = c.force.max(0.0);
             dl2 += (new - c.rec.lambda).powi(2);
             l2 += c.rec.lambda.powi(2);
         }
     }
-    let conv1 = max_dn <= p.contact.eps1 * dn_max;
     let conv2 = dl2 == 0.0 || dl2.sqrt() < p.contact.eps2 * l2.sqrt();
     (conv1, conv2)
 }
@@ -170,13 +167,8 @@ fn measure(p: &SolverParams, dn_max: f64, d: &[f64], active: &mut [Active]) -> (
 /// (P1) λ_k = λ_{k−1} + p_n d_n, kept non-negative, for every closed contact; and (P21): the
 /// penalty of a contact whose penetration does not fall fast enough is raised. Returns whether
 /// a penalty changed (K must be refactorized).
-fn update_multipliers(
-    cp: &ContactParams,
-    dn_max: f64,
-    alm_k: u32,
-    converged: bool,
-    active: &mut [Active],
-) -> bool {
+fn update_multipliers(p: &SolverParams, alm_k: u32, converged: bool, active: &mut [Active]) -> bool {
+    let cp = &p.contact;
     let mut raised = false;
     for c in active.iter_mut() {
         if c.rec.state == ContactState::Open {
@@ -191,7 +183,7 @@ fn update_multipliers(
             && alm_k <= PENALTY_ROUNDS + 1
             && !converged
             && c.dn.abs() > cp.beta * prev.abs()
-            && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * dn_max
+            && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * c.dn_max(p)
         {
             let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
             if capped > c.rec.penalty {
@@ -216,13 +208,16 @@ fn tangential_slip(c: &Active, d: &[f64], blocks: &[Block]) -> crate::physics::g
     du - n * n.dot(&du)
 }
 
-/// The largest tangential displacement of a locked contact in the solution `d`, m.
-fn stick_slip(inp: &AlmInputs, d: &[f64], active: &[Active]) -> f64 {
+/// Every locked contact is stuck: its tangential displacement in the solution `d` is within
+/// its stick tolerance.
+fn stuck(inp: &AlmInputs, d: &[f64], active: &[Active]) -> bool {
     active
         .iter()
         .filter(|c| c.rec.state == ContactState::Lock)
-        .map(|c| tangential_slip(c, d, inp.blocks).norm())
-        .fold(0.0, f64::max)
+        .all(|c| {
+            tangential_slip(c, d, inp.blocks).norm()
+                <= c.stick_tolerance(inp.params, inp.first_step)
+        })
 }
 
 /// The augmented Lagrangian update of a locked contact's shear, as (P1) is of its normal force:
@@ -234,7 +229,7 @@ fn stick_slip(inp: &AlmInputs, d: &[f64], active: &[Active]) -> f64 {
 /// 30° 3 % too far in 2 s, all of it gained in the first steps. The paper enforces only the
 /// normal constraint this way; its shear is a penalty spring.
 ///
-/// The tolerance (`AlmInputs::stick_tolerance`) is the normal one, ε1·d_n,max, except in the first
+/// The tolerance ([`Active::stick_tolerance`]) is the normal one, ε1·d_n,max, except in the first
 /// step of a run, where every contact takes up its load at once: there it is f0·w0, the slip
 /// the contact law does not count. With ε1·d_n,max there too, 5 × 10 m blocks took up their load
 /// with 0.12 mm of slip; with f0·w0 in every step, a struck wall of 100 blocks needed 158 solves
@@ -260,7 +255,7 @@ fn hold_reversed_friction(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
             continue;
         }
         let du = c.relative_displacement(d, inp.blocks);
-        if law::reversed(&du, &c.rec.tau, inp.slip_tolerance) {
+        if law::reversed(&du, &c.rec.tau, c.slip_tolerance(inp.params)) {
             c.friction_cap = Some(c.rec.lambda);
         }
     }

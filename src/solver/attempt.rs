@@ -8,7 +8,7 @@ use super::assemble::{StiffnessSync, block_terms};
 use super::counters::{Counters, Stopwatch};
 use super::open_close::{self, CheckInputs};
 use super::step_control::{self, Retry};
-use crate::contact::law::LawParams;
+use crate::contact::groups::ContactGroups;
 use crate::model::Block;
 use crate::params::{Method, SolverParams};
 use crate::physics::integrator::Scheme;
@@ -18,8 +18,8 @@ use crate::physics::linear::{BlockMatrix, SparseCholesky};
 pub(crate) struct AttemptInputs<'a> {
     pub params: &'a SolverParams,
     pub blocks: &'a [Block],
-    /// Shi's w0: half the largest extent of the initial model, m.
-    pub w0: f64,
+    /// The step's contact groups, with their w0 (`crate::contact::groups`).
+    pub groups: &'a ContactGroups,
     pub time: f64,
     pub dt: f64,
     /// The time integrator of this step.
@@ -50,7 +50,7 @@ pub(crate) fn attempt(
     let result = open_close_iteration(inp, kmat, chol, active, counters);
     counters.flush();
     let solved = result?;
-    step_control::check_solution(inp.params, inp.blocks, inp.w0, &solved.d, active)?;
+    step_control::check_solution(inp.params, inp.blocks, inp.groups, &solved.d, active)?;
     Ok(solved)
 }
 
@@ -71,13 +71,6 @@ fn open_close_iteration(
     // (K0, F0): the block terms of §3, fixed for the attempt.
     let (k0, f0) = block_terms(p, inp.blocks, &inp.scheme, inp.dt);
     counters.assembly += watch.elapsed();
-    let law = LawParams {
-        close_penetration: cp.close_threshold * inp.w0,
-        open_tension: cp.initial_penalty * (cp.open_threshold * inp.w0),
-        slip_tolerance: cp.open_threshold * inp.w0,
-        tan_phi: p.joint.friction_angle.to_radians().tan(),
-        eps2: cp.eps2,
-    };
     for c in active.iter_mut() {
         c.flips = 0;
         c.frozen = false;
@@ -91,13 +84,7 @@ fn open_close_iteration(
     };
     for pass in 0..=cp.max_open_close_iterations {
         if pass == cp.max_open_close_iterations {
-            open_close::settle_stragglers(
-                active,
-                p,
-                law.close_penetration,
-                inp.at_floor,
-                counters,
-            )?;
+            open_close::settle_stragglers(active, p, inp.at_floor, counters)?;
             solved.settled = true;
         }
         solved.oc_passes += 1;
@@ -106,13 +93,7 @@ fn open_close_iteration(
             blocks: inp.blocks,
             k0: &k0,
             f0: &f0,
-            dn_max: step_control::max_step_penetration(p, inp.w0),
-            slip_tolerance: law.slip_tolerance,
-            stick_tolerance: if inp.first_step {
-                law.slip_tolerance
-            } else {
-                cp.eps1 * step_control::max_step_penetration(p, inp.w0)
-            },
+            first_step: inp.first_step,
             settling: solved.settled,
         };
         let mut sys = System {
@@ -133,7 +114,6 @@ fn open_close_iteration(
         let check = CheckInputs {
             params: p,
             blocks: inp.blocks,
-            law,
             warm: cp.warm_start && p.method == Method::Alm,
             time: inp.time,
             dt: inp.dt,

@@ -30,11 +30,11 @@ use attempt::{AttemptInputs, Solved, attempt};
 use counters::{Counters, Stopwatch, debug_log};
 
 use crate::contact::ContactKey;
+use crate::contact::groups::{Bounds, ContactGroups};
 use crate::contact::record::ContactRecord;
 use crate::model::Model;
 use crate::params::{Mode, SolverParams};
 use crate::physics::geometry::Vec3;
-use crate::physics::geometry::bounding_box;
 use crate::physics::integrator::{Kinematics, Scheme};
 use crate::physics::linear::{BlockMatrix, SparseCholesky};
 use crate::snapshot::{
@@ -67,8 +67,10 @@ pub struct Solver {
     pub step: u64,
     /// The step length the next step starts from (before prediction), s.
     dt: f64,
-    /// Half the largest extent of the initial model (Shi's w0), m.
+    /// The largest contact group's w0 at the last step (`crate::contact::groups`), m.
     w0: f64,
+    /// Each block's initial bounding box, on which the groups' w0 are measured.
+    initial_boxes: Vec<(Vec3, Vec3)>,
     /// What each contact carries to the next step.
     records: HashMap<ContactKey, ContactRecord>,
     linear: LinearCache,
@@ -89,13 +91,14 @@ pub struct Solver {
 
 impl Solver {
     pub fn new(model: Model, params: SolverParams) -> Self {
-        let all: Vec<_> = model
+        let initial_boxes: Vec<_> = model.blocks.iter().map(|b| (b.lo, b.hi)).collect();
+        let bounds = model
             .blocks
             .iter()
-            .flat_map(|b| b.vertices.iter().copied())
+            .zip(&initial_boxes)
+            .map(|(b, &home)| Bounds::of(b, home))
             .collect();
-        let (lo, hi) = bounding_box(&all);
-        let w0 = 0.5 * (hi - lo).max();
+        let w0 = ContactGroups::find(bounds, params.max_displacement_ratio).largest_w0();
         let mut model = model;
         let stage = params
             .initial_equilibrium
@@ -108,6 +111,7 @@ impl Solver {
             time: 0.0,
             step: 0,
             w0,
+            initial_boxes,
             records: HashMap::new(),
             linear: LinearCache::default(),
             contacts: Vec::new(),
@@ -145,11 +149,12 @@ impl Solver {
         self.stage.is_some()
     }
 
+    /// Shi's w0 of the largest contact group (the model's, when all its blocks are linked), m.
     pub fn w0(&self) -> f64 {
         self.w0
     }
 
-    /// d_n,max = 2 δ w0 of (P22).
+    /// d_n,max = 2 δ w0 of (P22), at the largest contact group's w0.
     pub fn max_step_penetration(&self) -> f64 {
         step_control::max_step_penetration(&self.params, self.w0)
     }
@@ -275,13 +280,14 @@ impl Solver {
                 b.set_kinematics(Kinematics::at_rest());
             }
         }
-        let (mut active, mut kmat) = self.detect();
+        let (mut active, mut kmat, groups) = self.detect();
         self.totals.timings.detection += watch.seconds();
 
-        let predicted = step_control::predict_dt(&self.params, &self.model.blocks, self.w0);
+        let predicted = step_control::predict_dt(&self.params, &self.model.blocks, &groups);
         let base = self.dt.min(predicted);
         let first = step_control::first_attempt(base, room);
-        let (solved, dt, cuts, factorizations) = self.solve(&mut kmat, &mut active, first)?;
+        let (solved, dt, cuts, factorizations) =
+            self.solve(&mut kmat, &mut active, &groups, first)?;
 
         let watch = Stopwatch::start();
         let maps = commit::step_maps(&self.model.blocks, &solved.d);
@@ -314,17 +320,19 @@ impl Solver {
         Ok((dt, solved.settled))
     }
 
-    /// Stage 1: this step's contacts, and the global matrix laid out on their pattern.
-    fn detect(&mut self) -> (Vec<Active>, BlockMatrix) {
-        let (mut active, near) = activate(&ActivationInputs {
+    /// Stage 1: this step's contacts, the global matrix laid out on their pattern, and the
+    /// contact groups with their w0.
+    fn detect(&mut self) -> (Vec<Active>, BlockMatrix, ContactGroups) {
+        let (mut active, groups) = activate(&ActivationInputs {
             params: &self.params,
             blocks: &self.model.blocks,
             records: &self.records,
-            w0: self.w0,
+            initial_boxes: &self.initial_boxes,
             step: self.step,
             time: self.time,
         });
-        let pairs = assemble::sparsity_pattern(&active, &self.linear.pattern, &near);
+        self.w0 = groups.largest_w0();
+        let pairs = assemble::sparsity_pattern(&active, &self.linear.pattern, &groups.pairs);
         self.linear.pattern = pairs.clone();
         let kmat = BlockMatrix::new(self.model.blocks.len(), pairs);
         for c in &mut active {
@@ -333,7 +341,7 @@ impl Solver {
                 .pair_index(i, j)
                 .expect("pattern holds every contact pair");
         }
-        (active, kmat)
+        (active, kmat, groups)
     }
 
     /// Stages 2–4: attempts at the step from Δt = `first`, cut after each failure, until one
@@ -342,6 +350,7 @@ impl Solver {
         &mut self,
         kmat: &mut BlockMatrix,
         active: &mut [Active],
+        groups: &ContactGroups,
         first: f64,
     ) -> Result<(Solved, f64, u32, u32), SolverError> {
         let floor = step_control::dt_floor(&self.params);
@@ -354,7 +363,7 @@ impl Solver {
             let inputs = AttemptInputs {
                 params: &self.params,
                 blocks: &self.model.blocks,
-                w0: self.w0,
+                groups,
                 time: self.time,
                 dt,
                 scheme,

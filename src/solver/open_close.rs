@@ -7,7 +7,7 @@ use super::active::Active;
 use super::counters::{Counters, debug_log};
 use super::step_control::Retry;
 use crate::contact::ContactState;
-use crate::contact::law::{self, LawParams, Observation, Transition};
+use crate::contact::law::{self, Observation, Transition};
 use crate::model::Block;
 use crate::params::SolverParams;
 use crate::params::step_rules::SETTLE_FRACTION;
@@ -20,7 +20,6 @@ const MAX_FLIPS: u8 = 2;
 pub(crate) struct CheckInputs<'a> {
     pub params: &'a SolverParams,
     pub blocks: &'a [Block],
-    pub law: LawParams,
     /// Warm start in effect (ALM with `warm_start`): a contact closed at the start of the step
     /// and reopened in an earlier pass keeps its adapted penalty when it closes again.
     pub warm: bool,
@@ -63,7 +62,7 @@ pub(crate) fn check(
             // A contact that keeps cycling (typically an edge–edge and a vertex–face contact
             // of one block pair taking the load in turn) is settled for the rest of the
             // attempt (see `law::Settled`).
-            c.settle(inp.law.close_penetration, inp.params);
+            c.settle(inp.params);
             counters.totals.frozen_contacts += (before != c.rec.state) as u64;
             c.flips = 0;
             c.frozen = true;
@@ -104,7 +103,7 @@ fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
         held_friction: c.friction_cap,
         slid_before: c.start.state == ContactState::Slide,
     };
-    let verdict = law::classify(&seen, &inp.law);
+    let verdict = law::classify(&seen, &c.law(inp.params));
     if c.rec.state == ContactState::Lock && verdict != Transition::Open {
         c.shear = shear;
     }
@@ -147,7 +146,6 @@ fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
 pub(crate) fn settle_stragglers(
     active: &mut [Active],
     params: &SolverParams,
-    close_tol: f64,
     at_floor: bool,
     counters: &mut Counters,
 ) -> Result<(), Retry> {
@@ -156,7 +154,7 @@ pub(crate) fn settle_stragglers(
         return Err(Retry::OpenClose);
     }
     for c in active.iter_mut().filter(|c| c.changed) {
-        c.settle(close_tol, params);
+        c.settle(params);
         counters.totals.frozen_contacts += 1;
     }
     Ok(())

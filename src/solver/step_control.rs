@@ -5,6 +5,7 @@
 
 use super::active::Active;
 use crate::contact::DetectionParams;
+use crate::contact::groups::ContactGroups;
 use crate::model::Block;
 use crate::params::step_rules::{
     DISPLACEMENT_CUT_SAFETY, DT_CUT, DT_FLOOR_DIVISOR, DT_GROWTH, PREDICT_SAFETY,
@@ -12,6 +13,7 @@ use crate::params::step_rules::{
 use crate::params::{Mode, SolverParams};
 use crate::physics::geometry::Vec3;
 use crate::physics::mechanics::{Vec12, displacement_matrix};
+use crate::text::short;
 
 /// Why an attempt at a step failed and must be redone with a shorter Δt.
 pub(crate) enum Retry {
@@ -19,7 +21,7 @@ pub(crate) enum Retry {
     OpenClose,
     /// The largest vertex displacement was this many times δ·w0.
     Displacement(f64),
-    /// A closed contact penetrated this deep, m, beyond the contact window.
+    /// A closed contact penetrated this many times its contact window d_pen.
     Penetration(f64),
     /// The factorization failed or the solution is not finite.
     NotFinite,
@@ -31,11 +33,13 @@ impl Retry {
         match self {
             Retry::OpenClose => unreachable!("settled at the floor"),
             Retry::NotFinite => "the solution is not finite".to_string(),
-            Retry::Penetration(p) => {
-                format!("penetration {p:.3e} m exceeds the contact window at the minimum time step")
-            }
+            Retry::Penetration(r) => format!(
+                "a contact penetrated {} times its contact window at the minimum time step",
+                short(*r)
+            ),
             Retry::Displacement(r) => format!(
-                "vertex displacement {r:.1} times the allowed δ·w0 at the minimum time step"
+                "vertex displacement {} times the allowed δ·w0 at the minimum time step",
+                short(*r)
             ),
         }
     }
@@ -45,7 +49,7 @@ impl Retry {
         match self {
             Retry::OpenClose => "open-close".to_string(),
             Retry::Displacement(r) => format!("displacement r={r:.2}"),
-            Retry::Penetration(p) => format!("penetration {p:.2e}"),
+            Retry::Penetration(r) => format!("penetration r={r:.2}"),
             Retry::NotFinite => "not finite".to_string(),
         }
     }
@@ -93,61 +97,53 @@ pub(crate) fn next_dt(p: &SolverParams, base: f64, taken: f64, cuts: u32) -> f64
 }
 
 /// Δt such that the fastest vertex moves at most δ·w0 under its current velocity and gravity
-/// (Shi's prediction from ½ a Δt² + v Δt = δ w0).
-pub(crate) fn predict_dt(p: &SolverParams, blocks: &[Block], w0: f64) -> f64 {
-    let allowed = p.max_displacement_ratio * w0 * PREDICT_SAFETY;
+/// (Shi's prediction from ½ a Δt² + v Δt = δ w0), w0 being the block's contact group's, or the
+/// largest of those it may come near within Δt_max (see [`ContactGroups::w0_near`]).
+///
+/// A block that comes near no other block within Δt_max is in free flight: the step integrates
+/// its motion exactly, and δ·w0, which keeps the contact linearisation and the detection window
+/// valid, need not limit its step. (A rock that bounced off the ground slab's edge fell for
+/// 90 s at the Δt floor and was then reported as diverged.)
+pub(crate) fn predict_dt(p: &SolverParams, blocks: &[Block], groups: &ContactGroups) -> f64 {
     let a = Vec3::from(p.gravity).norm().max(1e-12);
     let mut dt = p.max_time_step;
     if p.mode == Mode::Static {
         return dt;
     }
-    let search = DetectionParams::new(w0, p.max_displacement_ratio).search_distance;
+    let dt_max = p.max_time_step;
+    // Δt from ½ a Δt² + v Δt = δ w0 (with the safety factor).
+    let limit = |speed: f64, w0: f64| {
+        let allowed = p.max_displacement_ratio * w0 * PREDICT_SAFETY;
+        (-speed + (speed * speed + 2.0 * a * allowed).sqrt()) / a
+    };
     for (i, b) in blocks.iter().enumerate().filter(|(_, b)| !b.fixed) {
         let v = &b.velocity;
         let r = b.radius();
         let speed = Vec3::new(v[0], v[1], v[2]).norm()
             + Vec3::new(v[3], v[4], v[5]).norm() * r
             + v.fixed_rows::<6>(6).norm() * r;
-        let t = (-speed + (speed * speed + 2.0 * a * allowed).sqrt()) / a;
-        if t < dt {
-            let dt_max = p.max_time_step;
-            let reach = speed * dt_max + 0.5 * a * dt_max * dt_max + search;
-            if isolated(blocks, i, reach) {
-                continue;
+        if limit(speed, groups.w0_of(i)) < dt {
+            let motion = speed * dt_max + 0.5 * a * dt_max * dt_max;
+            if let Some(w0) = groups.w0_near(i, motion) {
+                dt = dt.min(limit(speed, w0));
             }
-            dt = t;
         }
     }
     dt.max(dt_floor(p))
 }
 
-/// True when no other block comes within `reach` of block `i`'s bounding box: a block in free
-/// flight. The constant-acceleration step integrates its motion exactly, and δ·w0, which keeps
-/// the contact linearisation and the detection window valid, need not limit its step. (A rock
-/// that bounced off the ground slab's edge fell for 90 s at the Δt floor and was then reported
-/// as diverged.)
-pub(crate) fn isolated(blocks: &[Block], i: usize, reach: f64) -> bool {
-    let b = &blocks[i];
-    let (lo, hi) = (b.lo - Vec3::repeat(reach), b.hi + Vec3::repeat(reach));
-    blocks
-        .iter()
-        .enumerate()
-        .all(|(k, o)| k == i || (0..3).any(|d| o.hi[d] < lo[d] || o.lo[d] > hi[d]))
-}
-
 /// The step-size checks of a solved attempt: no vertex of a block in contact range moves more
-/// than `max_displacement_overshoot · δ·w0`, and no closed contact penetrates beyond the
-/// contact window d_pen.
+/// than `max_displacement_overshoot · δ·w0` (w0 of its group, or of the groups it comes near),
+/// and no closed contact penetrates beyond its contact window d_pen.
 pub(crate) fn check_solution(
     p: &SolverParams,
     blocks: &[Block],
-    w0: f64,
+    groups: &ContactGroups,
     d: &[f64],
     active: &[Active],
 ) -> Result<(), Retry> {
-    let allowed = p.max_displacement_ratio * w0;
-    let detection = DetectionParams::new(w0, p.max_displacement_ratio);
-    let mut max_u: f64 = 0.0;
+    let delta = p.max_displacement_ratio;
+    let mut r: f64 = 0.0;
     for (i, b) in blocks.iter().enumerate() {
         let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
         let u = b
@@ -155,25 +151,27 @@ pub(crate) fn check_solution(
             .iter()
             .map(|v| (displacement_matrix(&(v - b.mp.centroid)) * di).norm())
             .fold(0.0, f64::max);
-        // A block in free flight may move further (see `isolated`).
-        if u > allowed && isolated(blocks, i, u + detection.search_distance) {
+        let own = delta * groups.w0_of(i);
+        if u <= own {
+            r = r.max(u / own);
             continue;
         }
-        max_u = max_u.max(u);
+        // A block in free flight may move further (see `predict_dt`).
+        if let Some(w0) = groups.w0_near(i, u) {
+            r = r.max(u / (delta * w0));
+        }
     }
-    let r = max_u / allowed;
     if r > p.max_displacement_overshoot {
         return Err(Retry::Displacement(r));
     }
-    let worst = active
+    let window = |c: &Active| DetectionParams::new(c.w0, delta).max_penetration;
+    let beyond = active
         .iter()
-        .filter(|c| c.rec.state.is_closed())
-        .map(|c| c.dn)
-        .fold(0.0, f64::max);
-    if worst > detection.max_penetration {
-        return Err(Retry::Penetration(worst));
+        .filter(|c| c.rec.state.is_closed() && c.dn > window(c));
+    match beyond.map(|c| c.dn / window(c)).reduce(f64::max) {
+        Some(worst) => Err(Retry::Penetration(worst)),
+        None => Ok(()),
     }
-    Ok(())
 }
 
 #[cfg(test)]

@@ -1,0 +1,408 @@
+//! Shi's w0 per contact group. Shi scales every control length of a step — the displacement a
+//! step may make (δ·w0), the contact search distance (2.5 δ w0), the ALM tolerance
+//! (ε1·2δw0), the open and close thresholds — with w0, half the largest extent of the model.
+//! Taken over the whole scene, one distant block makes all of them huge: a fixed cube 1 km from
+//! the rockfall let every block move metres a step (12 GJ out of 2.7 MJ). Here "the model" is a
+//! *contact group*: blocks linked, directly or through others, by being within the search
+//! distance of each other. Each group has its own w0, from its own extent; a block that touches
+//! nothing is a group of its own. For a model whose blocks are all linked (every shipped scene)
+//! that is Shi's w0, and the results are those of the global w0; a block far away changes
+//! nothing, and memory and time follow the number of blocks, not the scene's extent.
+//!
+//! Linking is decided with the larger w0 of the two groups (so that a small rock approaching a
+//! column is seen at the column's search distance), and repeated until no group grows: groups
+//! only merge, so it ends, in two or three sweeps in practice. Fixed blocks link too (a slab
+//! under a column is part of its model), although no contact is sought between two of them.
+
+use crate::model::Block;
+use crate::physics::geometry::Vec3;
+
+/// What grouping sees of a block: its bounding box, the box it started in, and whether it is
+/// fixed.
+#[derive(Clone, Copy, Debug)]
+pub struct Bounds {
+    pub lo: Vec3,
+    pub hi: Vec3,
+    /// The block's initial box: a group's w0 is measured on its members' initial boxes, as
+    /// Shi's w0 is on the initial model. (On their current boxes, the few nanometres a fixed
+    /// block moves on its springs changed w0, and with it every step of a slide, in the 13th
+    /// digit; and a group would grow as its blocks spread.)
+    pub initial: (Vec3, Vec3),
+    pub fixed: bool,
+}
+
+impl Bounds {
+    /// A block's box as it stands, and as it started.
+    pub fn of(b: &Block, initial: (Vec3, Vec3)) -> Self {
+        Bounds {
+            lo: b.lo,
+            hi: b.hi,
+            initial,
+            fixed: b.fixed,
+        }
+    }
+
+    /// Half the largest extent of the initial box (a lone block's w0), m.
+    fn half_extent(&self) -> f64 {
+        0.5 * (self.initial.1 - self.initial.0).max()
+    }
+}
+
+/// Shi's search distance d_s = 2.5 δ w0 (reference §6.3).
+pub fn search_distance(w0: f64, delta: f64) -> f64 {
+    2.5 * delta * w0
+}
+
+/// The blocks sorted along the axis of the scene's largest extent, for sweeps and range
+/// queries: what lies near a box is found among the blocks whose start on that axis is within
+/// reach, not among all blocks.
+pub struct SweepIndex {
+    axis: usize,
+    order: Vec<usize>,
+    /// `lo[axis]` of the blocks in `order`.
+    starts: Vec<f64>,
+    /// The largest extent of a box along the axis.
+    widest: f64,
+}
+
+impl SweepIndex {
+    pub fn new(boxes: &[Bounds]) -> Self {
+        let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
+        for b in boxes {
+            lo = lo.inf(&b.lo);
+            hi = hi.sup(&b.hi);
+        }
+        let axis = if boxes.is_empty() {
+            0
+        } else {
+            (hi - lo).imax()
+        };
+        let mut order: Vec<usize> = (0..boxes.len()).collect();
+        order.sort_by(|&a, &b| boxes[a].lo[axis].total_cmp(&boxes[b].lo[axis]));
+        let starts = order.iter().map(|&k| boxes[k].lo[axis]).collect();
+        let widest = boxes
+            .iter()
+            .map(|b| b.hi[axis] - b.lo[axis])
+            .fold(0.0, f64::max);
+        SweepIndex {
+            axis,
+            order,
+            starts,
+            widest,
+        }
+    }
+
+    /// Pairs (a, b), a < b, sorted, whose boxes come within `window(a, b)` of each other on
+    /// every axis; `window` must not exceed `max_window`. Pairs of two fixed blocks are kept
+    /// only if `fixed_pairs`.
+    pub fn pairs(
+        &self,
+        boxes: &[Bounds],
+        max_window: f64,
+        fixed_pairs: bool,
+        window: impl Fn(usize, usize) -> f64,
+    ) -> Vec<(usize, usize)> {
+        let axis = self.axis;
+        let h = max_window / 2.0;
+        let mut pairs = Vec::new();
+        for (k, &a) in self.order.iter().enumerate() {
+            let sa = &boxes[a];
+            for &b in &self.order[k + 1..] {
+                let sb = &boxes[b];
+                // `within`'s test on the sweep axis at the largest window, negated.
+                if sb.lo[axis] - h > sa.hi[axis] + h {
+                    break;
+                }
+                if sa.fixed && sb.fixed && !fixed_pairs {
+                    continue;
+                }
+                if within(sa, sb, window(a, b)) {
+                    pairs.push((a.min(b), a.max(b)));
+                }
+            }
+        }
+        pairs.sort_unstable();
+        pairs
+    }
+
+    /// The blocks other than `i` whose boxes come within `reach(k)` of block `i`'s box on every
+    /// axis; `reach` must not exceed `max_reach`.
+    pub fn near<'s>(
+        &'s self,
+        boxes: &'s [Bounds],
+        i: usize,
+        max_reach: f64,
+        reach: impl Fn(usize) -> f64 + 's,
+    ) -> impl Iterator<Item = usize> + 's {
+        let b = &boxes[i];
+        // A box that starts before this cannot reach `b`; the slack covers round-off.
+        let slack = 1e-9 * (b.lo[self.axis].abs() + self.widest + max_reach);
+        let from = self
+            .starts
+            .partition_point(|&s| s < b.lo[self.axis] - max_reach - self.widest - slack);
+        let to = self
+            .starts
+            .partition_point(|&s| s <= b.hi[self.axis] + max_reach);
+        self.order[from..to]
+            .iter()
+            .copied()
+            .filter(move |&k| k != i && reaches(b, &boxes[k], reach(k)))
+    }
+}
+
+/// The test of Shi's broad phase, both boxes grown by half the window: `a` and `b` are within
+/// `window` of each other on every axis.
+fn within(a: &Bounds, b: &Bounds, window: f64) -> bool {
+    let h = window / 2.0;
+    (0..3).all(|d| a.lo[d] - h <= b.hi[d] + h && b.lo[d] - h <= a.hi[d] + h)
+}
+
+/// `o` comes within `reach` of `b` on every axis (`b` grown by `reach`).
+fn reaches(b: &Bounds, o: &Bounds, reach: f64) -> bool {
+    let (lo, hi) = (b.lo - Vec3::repeat(reach), b.hi + Vec3::repeat(reach));
+    !(0..3).any(|d| o.hi[d] < lo[d] || o.lo[d] > hi[d])
+}
+
+/// The contact groups of a step, with each group's w0 and the block pairs near enough for
+/// contact (the broad phase's result).
+pub struct ContactGroups {
+    /// The group of each block.
+    group: Vec<usize>,
+    /// Shi's w0 of each group, m (indexed by the group's representative block).
+    w0: Vec<f64>,
+    /// Pairs with a movable block within their group's search distance, sorted.
+    pub pairs: Vec<(usize, usize)>,
+    /// The boxes they were found from, and an index over them for range queries.
+    pub boxes: Vec<Bounds>,
+    pub index: SweepIndex,
+    delta: f64,
+}
+
+impl ContactGroups {
+    /// Groups the blocks with the displacement ratio δ (see the module doc).
+    pub fn find(boxes: Vec<Bounds>, delta: f64) -> Self {
+        let n = boxes.len();
+        let index = SweepIndex::new(&boxes);
+        let mut parent: Vec<usize> = (0..n).collect();
+        let mut w0: Vec<f64> = boxes.iter().map(Bounds::half_extent).collect();
+        loop {
+            let widest = w0.iter().copied().fold(0.0, f64::max);
+            let window = |a: usize, b: usize| {
+                search_distance(w0[root(&parent, a)].max(w0[root(&parent, b)]), delta)
+            };
+            let linked = index.pairs(&boxes, search_distance(widest, delta), true, window);
+            let mut merged = false;
+            for &(a, b) in &linked {
+                let (ra, rb) = (root(&parent, a), root(&parent, b));
+                if ra != rb {
+                    // The smaller index represents the group: the result does not depend on
+                    // the order of the pairs.
+                    parent[ra.max(rb)] = ra.min(rb);
+                    merged = true;
+                }
+            }
+            if !merged {
+                let pairs = linked
+                    .into_iter()
+                    .filter(|&(a, b)| !(boxes[a].fixed && boxes[b].fixed))
+                    .collect();
+                let group = (0..n).map(|k| root(&parent, k)).collect();
+                return ContactGroups {
+                    group,
+                    w0,
+                    pairs,
+                    boxes,
+                    index,
+                    delta,
+                };
+            }
+            w0 = group_w0(&boxes, &mut parent);
+        }
+    }
+
+    /// Shi's w0 for block `i`: its group's, m.
+    pub fn w0_of(&self, i: usize) -> f64 {
+        self.w0[self.group[i]]
+    }
+
+    /// The largest group's w0 (the model's, when all its blocks are linked), m.
+    pub fn largest_w0(&self) -> f64 {
+        self.group.iter().map(|&g| self.w0[g]).fold(0.0, f64::max)
+    }
+
+    /// The search distance of block `i`'s group, m.
+    pub fn search_distance_of(&self, i: usize) -> f64 {
+        search_distance(self.w0_of(i), self.delta)
+    }
+
+    /// The w0 that governs block `i` if it moves up to `motion` in this step: the largest of its
+    /// own group's and those of the blocks it may come within their search distance of; `None`
+    /// when it comes near no block (free flight).
+    pub fn w0_near(&self, i: usize, motion: f64) -> Option<f64> {
+        let wi = self.w0_of(i);
+        let widest = self.largest_w0();
+        let reach = |k: usize| motion + search_distance(wi.max(self.w0_of(k)), self.delta);
+        let max_reach = motion + search_distance(widest, self.delta);
+        self.index
+            .near(&self.boxes, i, max_reach, reach)
+            .map(|k| self.w0_of(k))
+            .reduce(f64::max)
+            .map(|w| w.max(wi))
+    }
+}
+
+/// The representative of `k`'s group.
+fn root(parent: &[usize], mut k: usize) -> usize {
+    while parent[k] != k {
+        k = parent[k];
+    }
+    k
+}
+
+/// Each group's w0, half the largest extent of the union of its members' initial boxes, indexed
+/// by its representative. Flattens `parent` on the way.
+fn group_w0(boxes: &[Bounds], parent: &mut [usize]) -> Vec<f64> {
+    let n = boxes.len();
+    let mut lo = vec![Vec3::repeat(f64::INFINITY); n];
+    let mut hi = vec![Vec3::repeat(f64::NEG_INFINITY); n];
+    for k in 0..n {
+        let r = root(parent, k);
+        parent[k] = r;
+        lo[r] = lo[r].inf(&boxes[k].initial.0);
+        hi[r] = hi[r].sup(&boxes[k].initial.1);
+    }
+    (0..n)
+        .map(|r| {
+            if parent[r] == r {
+                0.5 * (hi[r] - lo[r]).max()
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cube(x: f64, y: f64, z: f64, size: f64, fixed: bool) -> Bounds {
+        let h = Vec3::repeat(size / 2.0);
+        let c = Vec3::new(x, y, z);
+        Bounds {
+            lo: c - h,
+            hi: c + h,
+            initial: (c - h, c + h),
+            fixed,
+        }
+    }
+
+    /// A slab with a stack of cubes on it, as the rockfall's column.
+    fn stack() -> Vec<Bounds> {
+        let (lo, hi) = (Vec3::new(-9.0, -9.0, -1.0), Vec3::new(9.0, 9.0, 0.0));
+        let mut b = vec![Bounds {
+            lo,
+            hi,
+            initial: (lo, hi),
+            fixed: true,
+        }];
+        for k in 0..4 {
+            b.push(cube(0.0, 0.0, 0.5 + k as f64, 1.0, k == 0));
+        }
+        b
+    }
+
+    #[test]
+    fn a_linked_model_has_shis_w0() {
+        let g = ContactGroups::find(stack(), 0.01);
+        for i in 0..5 {
+            assert_eq!(g.w0_of(i), 9.0);
+        }
+        // Contact pairs: each cube with the next; the slab and the fixed base cube are both
+        // fixed, so no contact is sought between them.
+        assert_eq!(g.pairs, vec![(1, 2), (2, 3), (3, 4)]);
+    }
+
+    #[test]
+    fn a_distant_block_is_a_group_of_its_own_and_changes_nothing() {
+        let alone = ContactGroups::find(stack(), 0.01);
+        for far in [12.0, 1e3, 1e5] {
+            let mut boxes = stack();
+            boxes.push(cube(far, 0.0, 0.5, 1.0, true));
+            let g = ContactGroups::find(boxes, 0.01);
+            for i in 0..5 {
+                assert_eq!(g.w0_of(i), alone.w0_of(i), "far = {far}");
+            }
+            assert_eq!(g.w0_of(5), 0.5);
+            assert_eq!(g.pairs, alone.pairs);
+        }
+    }
+
+    #[test]
+    fn a_small_block_is_linked_at_the_larger_groups_search_distance() {
+        // The cube's own window (2.5 δ · 0.5 = 0.0125 m) would not reach a gap of 0.2 m; the
+        // slab group's (2.5 δ · 9 = 0.225 m) does.
+        let mut boxes = stack();
+        boxes.push(cube(1.7, 0.0, 0.5 + 0.2 + 0.5, 1.0, false));
+        let g = ContactGroups::find(boxes.clone(), 0.01);
+        assert_eq!(g.w0_of(5), 9.0);
+        assert!(g.pairs.contains(&(0, 5)));
+        boxes[5] = cube(1.7, 0.0, 0.5 + 0.3 + 0.5, 1.0, false);
+        let g = ContactGroups::find(boxes, 0.01);
+        assert_eq!(g.w0_of(5), 0.5);
+        assert!(!g.pairs.contains(&(0, 5)));
+        // In free flight 0.3 m above the slab, it is near it once it may move 0.1 m.
+        assert_eq!(g.w0_near(5, 0.0), None);
+        assert_eq!(g.w0_near(5, 0.1), Some(9.0));
+    }
+
+    #[test]
+    fn chains_link_through_their_members_whatever_the_order() {
+        // A row of cubes 1 cm apart: one group whatever the order they are listed in.
+        let n = 30;
+        let mut boxes: Vec<Bounds> = (0..n)
+            .map(|k| cube(1.01 * k as f64, 0.0, 0.0, 1.0, false))
+            .collect();
+        let g = ContactGroups::find(boxes.clone(), 0.01);
+        let w = 0.5 * (1.01 * (n - 1) as f64 + 1.0);
+        assert!((0..n).all(|i| (g.w0_of(i) - w).abs() < 1e-12));
+        boxes.reverse();
+        let r = ContactGroups::find(boxes, 0.01);
+        assert!((0..n).all(|i| r.w0_of(i) == g.w0_of(n - 1 - i)));
+        assert_eq!(g.pairs.len(), n - 1);
+    }
+
+    #[test]
+    fn range_queries_match_a_scan_of_all_blocks() {
+        // A pseudo-random scatter of boxes of mixed sizes; `near` must find exactly what a
+        // scan of every block finds.
+        let mut seed = 7u64;
+        let mut rnd = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let boxes: Vec<Bounds> = (0..300)
+            .map(|_| cube(40.0 * rnd(), 10.0 * rnd(), 5.0 * rnd(), 0.2 + 3.0 * rnd(), false))
+            .collect();
+        let index = SweepIndex::new(&boxes);
+        for i in 0..boxes.len() {
+            let reach = |k: usize| 0.1 * (k % 7) as f64;
+            let mut fast: Vec<usize> = index.near(&boxes, i, 0.6, reach).collect();
+            fast.sort_unstable();
+            let slow: Vec<usize> = (0..boxes.len())
+                .filter(|&k| k != i && reaches(&boxes[i], &boxes[k], reach(k)))
+                .collect();
+            assert_eq!(fast, slow, "block {i}");
+        }
+        let pairs = index.pairs(&boxes, 0.3, true, |a, b| 0.1 * ((a + b) % 4) as f64);
+        let mut slow = Vec::new();
+        for a in 0..boxes.len() {
+            for b in a + 1..boxes.len() {
+                if within(&boxes[a], &boxes[b], 0.1 * ((a + b) % 4) as f64) {
+                    slow.push((a, b));
+                }
+            }
+        }
+        assert_eq!(pairs, slow);
+    }
+}
