@@ -3,14 +3,16 @@
 
 use std::fmt::Write;
 
+use crate::contact::groups::SIZE_RATIO;
+
 /// A wall of `blocks` jointed blocks (1.2 m × 1.2 m × 2.0 m, as in the rockfall scene), stacked
 /// `layers` high in columns standing side by side along y, the bottom layer fixed, struck at
 /// mid-length by a dodecahedral rock thrown at 10 m/s. `blocks = 5, layers = 5` is the paper's
 /// five-block column.
 ///
-/// δ is set so that δ·w0 = 0.05 m whatever the wall's length: Shi's control lengths (search
-/// distance, penetration tolerance) scale with w0, and on a 240 m wall the paper's δ = 0.01 would
-/// let a vertex move 1.2 m a step and search for contacts 3 m away, across neighbouring blocks.
+/// δ is set so that δ·w0 = 0.05 m whatever the wall's length, w0 being the blocks' (their group's
+/// w0, at most [`SIZE_RATIO`] times a block's half-extent: 10 m). Shi's control lengths (search
+/// distance, penetration tolerance) scale with w0.
 pub fn column_wall(blocks: usize, layers: usize, rock: bool) -> String {
     let layers = layers.clamp(1, blocks.max(1));
     let columns = blocks.div_ceil(layers);
@@ -21,7 +23,7 @@ pub fn column_wall(blocks: usize, layers: usize, rock: bool) -> String {
     // Ground slab: under the wall and 10 m out on both sides in x.
     let ground: (f64, f64, f64) = (20.0, length + 8.0, 1.0);
     let extent = ground.0.max(ground.1).max(height + 1.0);
-    let w0 = extent / 2.0;
+    let w0 = (extent / 2.0).min(SIZE_RATIO * 0.5 * bz);
     let delta = 0.05 / w0;
     let mut s = String::new();
     let _ = writeln!(

@@ -163,6 +163,15 @@ fn reaches(b: &Bounds, o: &Bounds, reach: f64) -> bool {
     !(0..3).any(|d| o.hi[d] < lo[d] || o.lo[d] > hi[d])
 }
 
+/// A block's steps and contacts are measured on at most this many times its own half-extent:
+/// in a long chain of touching blocks (a 2 km strip of 1 m cubes) the group's w0 is 1 km, which
+/// would let a 1 m cube move 10 m a step and search 25 m around it for contacts. With the cap, a
+/// step moves a block at most 10 δ of its half-extent (5 % of its size at the paper's δ = 0.01),
+/// the search window stays a few centimetres, and memory and time follow the number of blocks.
+/// Ten keeps Shi's w0 for every shipped scene (the rockfall's 1 m column blocks on an 18 m slab:
+/// min(9 m, 10 × 1 m) = 9 m).
+pub const SIZE_RATIO: f64 = 10.0;
+
 /// The contact groups of a step, with each group's w0 and the block pairs near enough for
 /// contact (the broad phase's result).
 pub struct ContactGroups {
@@ -170,7 +179,9 @@ pub struct ContactGroups {
     group: Vec<usize>,
     /// Shi's w0 of each group, m (indexed by the group's representative block).
     w0: Vec<f64>,
-    /// Pairs with a movable block within their group's search distance, sorted.
+    /// [`SIZE_RATIO`] times each block's half-extent, m.
+    cap: Vec<f64>,
+    /// Pairs with a movable block within their search distance, sorted.
     pub pairs: Vec<(usize, usize)>,
     /// The boxes they were found from, and an index over them for range queries.
     pub boxes: Vec<Bounds>,
@@ -184,12 +195,12 @@ impl ContactGroups {
         let n = boxes.len();
         let index = SweepIndex::new(&boxes);
         let mut parent: Vec<usize> = (0..n).collect();
+        let cap: Vec<f64> = boxes.iter().map(|b| SIZE_RATIO * b.half_extent()).collect();
         let mut w0: Vec<f64> = boxes.iter().map(Bounds::half_extent).collect();
         loop {
-            let widest = w0.iter().copied().fold(0.0, f64::max);
-            let window = |a: usize, b: usize| {
-                search_distance(w0[root(&parent, a)].max(w0[root(&parent, b)]), delta)
-            };
+            let own: Vec<f64> = (0..n).map(|k| w0[root(&parent, k)].min(cap[k])).collect();
+            let widest = own.iter().copied().fold(0.0, f64::max);
+            let window = |a: usize, b: usize| search_distance(own[a].max(own[b]), delta);
             let linked = index.pairs(&boxes, search_distance(widest, delta), true, window);
             let mut merged = false;
             for &(a, b) in &linked {
@@ -210,6 +221,7 @@ impl ContactGroups {
                 return ContactGroups {
                     group,
                     w0,
+                    cap,
                     pairs,
                     boxes,
                     index,
@@ -220,9 +232,31 @@ impl ContactGroups {
         }
     }
 
-    /// Shi's w0 for block `i`: its group's, m.
-    pub fn w0_of(&self, i: usize) -> f64 {
+    /// Shi's w0 of block `i`'s group, m.
+    pub fn group_w0(&self, i: usize) -> f64 {
         self.w0[self.group[i]]
+    }
+
+    /// The w0 block `i` is measured on by itself: its group's, at most [`SIZE_RATIO`] times its
+    /// half-extent, m. Its search distance is Shi's at this w0.
+    pub fn own_w0(&self, i: usize) -> f64 {
+        self.group_w0(i).min(self.cap[i])
+    }
+
+    /// The w0 of a contact between blocks `a` and `b`, m: the larger of their groups' (they are
+    /// one group once in contact), at most [`SIZE_RATIO`] times the smaller block's half-extent.
+    /// Its thresholds and tolerances, and the steps of both blocks, are measured on it.
+    pub fn pair_w0(&self, a: usize, b: usize) -> f64 {
+        self.group_w0(a)
+            .max(self.group_w0(b))
+            .min(self.cap[a])
+            .min(self.cap[b])
+    }
+
+    /// The w0 the contact search between `a` and `b` uses, m: the larger of their own, so that
+    /// the faster of the two is seen coming.
+    pub fn search_w0(&self, a: usize, b: usize) -> f64 {
+        self.own_w0(a).max(self.own_w0(b))
     }
 
     /// The largest group's w0 (the model's, when all its blocks are linked), m.
@@ -230,24 +264,23 @@ impl ContactGroups {
         self.group.iter().map(|&g| self.w0[g]).fold(0.0, f64::max)
     }
 
-    /// The search distance of block `i`'s group, m.
-    pub fn search_distance_of(&self, i: usize) -> f64 {
-        search_distance(self.w0_of(i), self.delta)
+    /// An upper bound of the w0 block `i`'s step can be measured on, m.
+    pub fn max_w0(&self, i: usize) -> f64 {
+        self.largest_w0().min(self.cap[i])
     }
 
-    /// The w0 that governs block `i` if it moves up to `motion` in this step: the largest of its
-    /// own group's and those of the blocks it may come within their search distance of; `None`
+    /// The w0 that governs block `i` if it moves up to `motion` in this step: the smallest
+    /// [`Self::pair_w0`] with the blocks it may come within their search distance of; `None`
     /// when it comes near no block (free flight).
     pub fn w0_near(&self, i: usize, motion: f64) -> Option<f64> {
-        let wi = self.w0_of(i);
+        let own = self.own_w0(i);
         let widest = self.largest_w0();
-        let reach = |k: usize| motion + search_distance(wi.max(self.w0_of(k)), self.delta);
+        let reach = |k: usize| motion + search_distance(own.max(self.own_w0(k)), self.delta);
         let max_reach = motion + search_distance(widest, self.delta);
         self.index
             .near(&self.boxes, i, max_reach, reach)
-            .map(|k| self.w0_of(k))
-            .reduce(f64::max)
-            .map(|w| w.max(wi))
+            .map(|k| self.pair_w0(i, k))
+            .reduce(f64::min)
     }
 }
 
@@ -316,7 +349,7 @@ mod tests {
     fn a_linked_model_has_shis_w0() {
         let g = ContactGroups::find(stack(), 0.01);
         for i in 0..5 {
-            assert_eq!(g.w0_of(i), 9.0);
+            assert_eq!(g.group_w0(i), 9.0);
         }
         // Contact pairs: each cube with the next; the slab and the fixed base cube are both
         // fixed, so no contact is sought between them.
@@ -331,9 +364,9 @@ mod tests {
             boxes.push(cube(far, 0.0, 0.5, 1.0, true));
             let g = ContactGroups::find(boxes, 0.01);
             for i in 0..5 {
-                assert_eq!(g.w0_of(i), alone.w0_of(i), "far = {far}");
+                assert_eq!(g.group_w0(i), alone.group_w0(i), "far = {far}");
             }
-            assert_eq!(g.w0_of(5), 0.5);
+            assert_eq!(g.group_w0(5), 0.5);
             assert_eq!(g.pairs, alone.pairs);
         }
     }
@@ -345,11 +378,11 @@ mod tests {
         let mut boxes = stack();
         boxes.push(cube(1.7, 0.0, 0.5 + 0.2 + 0.5, 1.0, false));
         let g = ContactGroups::find(boxes.clone(), 0.01);
-        assert_eq!(g.w0_of(5), 9.0);
+        assert_eq!(g.group_w0(5), 9.0);
         assert!(g.pairs.contains(&(0, 5)));
         boxes[5] = cube(1.7, 0.0, 0.5 + 0.3 + 0.5, 1.0, false);
         let g = ContactGroups::find(boxes, 0.01);
-        assert_eq!(g.w0_of(5), 0.5);
+        assert_eq!(g.group_w0(5), 0.5);
         assert!(!g.pairs.contains(&(0, 5)));
         // In free flight 0.3 m above the slab, it is near it once it may move 0.1 m.
         assert_eq!(g.w0_near(5, 0.0), None);
@@ -365,10 +398,10 @@ mod tests {
             .collect();
         let g = ContactGroups::find(boxes.clone(), 0.01);
         let w = 0.5 * (1.01 * (n - 1) as f64 + 1.0);
-        assert!((0..n).all(|i| (g.w0_of(i) - w).abs() < 1e-12));
+        assert!((0..n).all(|i| (g.group_w0(i) - w).abs() < 1e-12));
         boxes.reverse();
         let r = ContactGroups::find(boxes, 0.01);
-        assert!((0..n).all(|i| r.w0_of(i) == g.w0_of(n - 1 - i)));
+        assert!((0..n).all(|i| r.group_w0(i) == g.group_w0(n - 1 - i)));
         assert_eq!(g.pairs.len(), n - 1);
     }
 
@@ -378,11 +411,21 @@ mod tests {
         // scan of every block finds.
         let mut seed = 7u64;
         let mut rnd = || {
-            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (seed >> 11) as f64 / (1u64 << 53) as f64
         };
         let boxes: Vec<Bounds> = (0..300)
-            .map(|_| cube(40.0 * rnd(), 10.0 * rnd(), 5.0 * rnd(), 0.2 + 3.0 * rnd(), false))
+            .map(|_| {
+                cube(
+                    40.0 * rnd(),
+                    10.0 * rnd(),
+                    5.0 * rnd(),
+                    0.2 + 3.0 * rnd(),
+                    false,
+                )
+            })
             .collect();
         let index = SweepIndex::new(&boxes);
         for i in 0..boxes.len() {

@@ -47,7 +47,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let known = |k: &ContactKey| inp.records.contains_key(k);
     let mut cands: Vec<Candidate> = Vec::new();
     for &(a, b) in &groups.pairs {
-        let dp = DetectionParams::new(groups.w0_of(a), p.max_displacement_ratio);
+        let dp = DetectionParams::new(groups.pair_w0(a, b), p.max_displacement_ratio);
         cands.extend(detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known));
     }
     // Contact transfer: a vertex that slid onto an adjacent, almost coplanar face of the same
@@ -61,7 +61,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let mut active: Vec<Active> = cands
         .into_iter()
         .map(|cand| {
-            let w0 = groups.w0_of(cand.key.i as usize);
+            let w0 = groups.pair_w0(cand.key.i as usize, cand.key.j as usize);
             activate_one(inp, &by_vertex, cand, w0)
         })
         .collect();

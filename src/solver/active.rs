@@ -1,8 +1,8 @@
 //! A contact inside a step: its geometry frozen at the start of the step, the record it carries,
 //! and the working values of the iterations (d_n, N, the flips of the open–close check).
 
-use crate::contact::kinematics::NormalKinematics;
 use super::step_control::max_step_penetration;
+use crate::contact::kinematics::NormalKinematics;
 use crate::contact::law::{self, LawParams, Settled};
 use crate::contact::record::ContactRecord;
 use crate::contact::{Candidate, ContactState};

@@ -167,7 +167,12 @@ fn measure(p: &SolverParams, d: &[f64], active: &mut [Active]) -> (bool, bool) {
 /// (P1) λ_k = λ_{k−1} + p_n d_n, kept non-negative, for every closed contact; and (P21): the
 /// penalty of a contact whose penetration does not fall fast enough is raised. Returns whether
 /// a penalty changed (K must be refactorized).
-fn update_multipliers(p: &SolverParams, alm_k: u32, converged: bool, active: &mut [Active]) -> bool {
+fn update_multipliers(
+    p: &SolverParams,
+    alm_k: u32,
+    converged: bool,
+    active: &mut [Active],
+) -> bool {
     let cp = &p.contact;
     let mut raised = false;
     for c in active.iter_mut() {

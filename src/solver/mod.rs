@@ -21,6 +21,7 @@ mod counters;
 mod equilibrium;
 mod open_close;
 mod step_control;
+pub mod watchdog;
 
 use std::collections::HashMap;
 
@@ -28,6 +29,7 @@ use activate::{ActivationInputs, activate};
 use active::Active;
 use attempt::{AttemptInputs, Solved, attempt};
 use counters::{Counters, Stopwatch, debug_log};
+use watchdog::EnergyWatch;
 
 use crate::contact::ContactKey;
 use crate::contact::groups::{Bounds, ContactGroups};
@@ -87,6 +89,8 @@ pub struct Solver {
     equilibrium: Option<EquilibriumReport>,
     /// The blocks carry the acceleration of a dynamic step (see [`Solver::scheme`]).
     accelerations: bool,
+    /// The energy balance since the start of the run (after the equilibrium stage).
+    energy: Option<EnergyWatch>,
 }
 
 impl Solver {
@@ -104,6 +108,9 @@ impl Solver {
             .initial_equilibrium
             .then(|| equilibrium::Stage::begin(&mut model.blocks, params.equilibrium_tolerance));
         let last = commit::with_energy(StepStats::default(), &model.blocks, params.gravity);
+        let energy = stage
+            .is_none()
+            .then(|| EnergyWatch::begin(&model.blocks, params.gravity, &last));
         Solver {
             dt: params.max_time_step,
             params,
@@ -121,6 +128,7 @@ impl Solver {
             stage,
             equilibrium: None,
             accelerations: false,
+            energy,
         }
     }
 
@@ -175,20 +183,32 @@ impl Solver {
             return self.equilibrium_step();
         }
         let limit = limit.min(self.params.duration);
+        let load_points = EnergyWatch::load_points(&self.model.blocks);
         let (dt, _) = self.advance(limit - self.time)?;
         self.time += dt;
         self.step += 1;
+        let energy = self.energy.as_mut().map(|w| {
+            w.add_load_work(&load_points, &self.model.blocks);
+            (w.gain_ratio(&self.last), w.check(&self.last))
+        });
         if debug_log() {
             let l = &self.last;
             eprintln!(
-                "step t={:.4} dt={dt:.2e} kinetic={:.4e} potential={:.6e} elastic={:.4e} passes={} factorizations={}",
+                "step t={:.4} dt={dt:.2e} kinetic={:.4e} potential={:.6e} elastic={:.4e} gain={:.3e} passes={} factorizations={}",
                 self.time,
                 l.kinetic_energy,
                 l.potential_energy,
                 l.elastic_energy,
+                energy.as_ref().map_or(0.0, |e| e.0),
                 l.open_close_iterations,
                 l.factorizations
             );
+        }
+        if let Some((_, Err(reason))) = energy {
+            return Err(SolverError::Diverged {
+                time: self.time,
+                reason,
+            });
         }
         Ok(&self.last)
     }
@@ -243,6 +263,11 @@ impl Solver {
                 &self.model.blocks,
                 self.params.gravity,
             );
+            self.energy = Some(EnergyWatch::begin(
+                &self.model.blocks,
+                self.params.gravity,
+                &self.last,
+            ));
         }
         Ok(&self.last)
     }

@@ -97,8 +97,8 @@ pub(crate) fn next_dt(p: &SolverParams, base: f64, taken: f64, cuts: u32) -> f64
 }
 
 /// Δt such that the fastest vertex moves at most δ·w0 under its current velocity and gravity
-/// (Shi's prediction from ½ a Δt² + v Δt = δ w0), w0 being the block's contact group's, or the
-/// largest of those it may come near within Δt_max (see [`ContactGroups::w0_near`]).
+/// (Shi's prediction from ½ a Δt² + v Δt = δ w0), w0 being that of the contacts the block may
+/// make within Δt_max (see [`ContactGroups::w0_near`]).
 ///
 /// A block that comes near no other block within Δt_max is in free flight: the step integrates
 /// its motion exactly, and δ·w0, which keeps the contact linearisation and the detection window
@@ -122,7 +122,7 @@ pub(crate) fn predict_dt(p: &SolverParams, blocks: &[Block], groups: &ContactGro
         let speed = Vec3::new(v[0], v[1], v[2]).norm()
             + Vec3::new(v[3], v[4], v[5]).norm() * r
             + v.fixed_rows::<6>(6).norm() * r;
-        if limit(speed, groups.w0_of(i)) < dt {
+        if limit(speed, groups.max_w0(i)) < dt {
             let motion = speed * dt_max + 0.5 * a * dt_max * dt_max;
             if let Some(w0) = groups.w0_near(i, motion) {
                 dt = dt.min(limit(speed, w0));
@@ -133,8 +133,8 @@ pub(crate) fn predict_dt(p: &SolverParams, blocks: &[Block], groups: &ContactGro
 }
 
 /// The step-size checks of a solved attempt: no vertex of a block in contact range moves more
-/// than `max_displacement_overshoot · δ·w0` (w0 of its group, or of the groups it comes near),
-/// and no closed contact penetrates beyond its contact window d_pen.
+/// than `max_displacement_overshoot · δ·w0` (w0 of the contacts it may make,
+/// [`ContactGroups::w0_near`]), and no closed contact penetrates beyond its contact window d_pen.
 pub(crate) fn check_solution(
     p: &SolverParams,
     blocks: &[Block],
@@ -151,13 +151,11 @@ pub(crate) fn check_solution(
             .iter()
             .map(|v| (displacement_matrix(&(v - b.mp.centroid)) * di).norm())
             .fold(0.0, f64::max);
-        let own = delta * groups.w0_of(i);
-        if u <= own {
-            r = r.max(u / own);
-            continue;
-        }
-        // A block in free flight may move further (see `predict_dt`).
-        if let Some(w0) = groups.w0_near(i, u) {
+        // A block in free flight may move further (see `predict_dt`). (Its r would be at most
+        // 1 where it did not: `max_displacement_overshoot` is at least 1.)
+        if u > 0.0
+            && let Some(w0) = groups.w0_near(i, u)
+        {
             r = r.max(u / (delta * w0));
         }
     }
