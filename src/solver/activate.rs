@@ -61,7 +61,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let mut active: Vec<Active> = cands
         .into_iter()
         .map(|cand| {
-            let w0 = groups.pair_w0(cand.key.i as usize, cand.key.j as usize);
+            let w0 = groups.group_w0(cand.key.i as usize);
             activate_one(inp, &by_vertex, cand, w0)
         })
         .collect();

@@ -25,7 +25,7 @@ pub(crate) struct Active {
     /// The smaller Young's modulus of the two blocks: the cap γE of (P21b).
     pub young: f64,
     /// Shi's w0 of the contact's group (`crate::contact::groups`), m: the length its
-    /// thresholds and tolerances scale with.
+    /// thresholds and ALM tolerances scale with.
     pub w0: f64,
     /// d_n after the last solve (5.4), m.
     pub dn: f64,

@@ -241,7 +241,7 @@ mod tests {
             params: &solver.params,
             blocks: &solver.model.blocks,
             records: &solver.records,
-            w0: solver.w0,
+            initial_boxes: &solver.initial_boxes,
             step: solver.step,
             time: solver.time,
         });

@@ -162,7 +162,10 @@ pub(crate) fn check_solution(
     if r > p.max_displacement_overshoot {
         return Err(Retry::Displacement(r));
     }
-    let window = |c: &Active| DetectionParams::new(c.w0, delta).max_penetration;
+    let window = |c: &Active| {
+        let (i, j) = c.blocks();
+        DetectionParams::new(groups.pair_w0(i, j), delta).max_penetration
+    };
     let beyond = active
         .iter()
         .filter(|c| c.rec.state.is_closed() && c.dn > window(c));
