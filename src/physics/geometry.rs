@@ -132,24 +132,27 @@ pub(super) fn any_perpendicular(n: &Vec3) -> Vec3 {
 impl Topology {
     /// Derives edges and vertex adjacency from faces; fails unless every edge has two faces.
     pub fn from_faces(n_vertices: usize, faces: Vec<Vec<usize>>) -> Result<Self, GeometryError> {
-        // Sorting (edge, face) pairs rather than filling a map keeps this O(E log E) without an
-        // allocation per edge: a scanned block has hundreds of thousands of edges.
-        let mut sides: Vec<(usize, usize, usize)> = Vec::new();
+        // Sorting (edge, face) keys rather than filling a map of vectors keeps this fast without
+        // an allocation per edge: a scanned block has hundreds of thousands of edges. A key is
+        // (low vertex, high vertex, face) in 32 bits each, compared as one number.
+        let mut sides: Vec<u128> = Vec::new();
         for (fi, f) in faces.iter().enumerate() {
             for k in 0..f.len() {
                 let (a, b) = (f[k], f[(k + 1) % f.len()]);
-                sides.push((a.min(b), a.max(b), fi));
+                let key = [a.min(b), a.max(b), fi].map(|x| u128::from(x as u32));
+                sides.push(key[0] << 64 | key[1] << 32 | key[2]);
             }
         }
         sides.sort_unstable();
         let mut edges = Vec::with_capacity(sides.len() / 2);
-        for run in sides.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        for run in sides.chunk_by(|x, y| x >> 32 == y >> 32) {
             if run.len() != 2 {
                 return Err(GeometryError::NotClosed);
             }
+            let part = |x: u128, shift: u32| (x >> shift) as u32 as usize;
             edges.push(Edge {
-                v: [run[0].0, run[0].1],
-                faces: [run[0].2, run[1].2],
+                v: [part(run[0], 64), part(run[0], 32)],
+                faces: [part(run[0], 0), part(run[1], 0)],
             });
         }
         // Euler's formula for a convex polyhedron: V − E + F = 2.

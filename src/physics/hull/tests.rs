@@ -410,3 +410,53 @@ fn sampled_faces_come_back_whole() {
         check_polyhedron(&cyl, &v, &t);
     }
 }
+
+/// Clouds rounded to a coarse grid, some rotated, some 1000 km out: many points on the faces,
+/// on the edges and on each other's planes. Where the former hull gave an answer, the new one
+/// is the same, vertex for vertex and face for face; it is always a convex polyhedron.
+#[test]
+fn gridded_clouds_match_the_former_hull() {
+    let mut rng = Lcg(12345);
+    for k in 0..1500 {
+        let n = 4 + k % 37;
+        let grid = [1.0, 4.0, 16.0, 0.0, 1e3][k % 5];
+        let r = rotation_xyz_degrees(rng.angles());
+        let offset = Vec3::new(1e6, 0.0, 0.0) * f64::from(u8::from(k % 7 == 0));
+        let pts: Vec<Vec3> = (0..n)
+            .map(|_| {
+                let mut p = match k % 4 {
+                    0 => rng.on_sphere(),
+                    1 => rng.in_cube(),
+                    2 => rng.in_ball(),
+                    _ => {
+                        // On the faces of the cube.
+                        let mut q = rng.in_cube();
+                        let a = (rng.next() * 3.0) as usize;
+                        q[a] = q[a].signum();
+                        q
+                    }
+                };
+                if grid > 0.0 {
+                    p = (p * grid).map(f64::round) / grid;
+                }
+                if k % 3 == 0 {
+                    p = r * p;
+                }
+                p + offset
+            })
+            .collect();
+        let new = convex_hull(&pts);
+        if let Ok((v, t)) = &new {
+            check_polyhedron(&pts, v, t);
+        }
+        let old = convex_hull_reference(&pts);
+        if old.is_ok()
+            || matches!(
+                old,
+                Err(GeometryError::Flat | GeometryError::TooFewVertices(_))
+            )
+        {
+            assert_eq!(new, old, "k = {k}");
+        }
+    }
+}
