@@ -3,6 +3,9 @@
 
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
+use super::hull;
+use crate::text::short;
+
 pub type Vec3 = Vector3<f64>;
 pub type Mat3 = Matrix3<f64>;
 
@@ -17,7 +20,20 @@ pub enum GeometryError {
     Flat,
     #[error("the convex hull is not a closed polyhedron")]
     NotClosed,
+    /// The block is too small for its distance from the origin: its corners differ in digits
+    /// that f64 no longer holds, so its faces (and any motion of it) cannot be resolved.
+    #[error(
+        "coordinates up to {} m cannot resolve a block {} m across (f64 keeps 16 digits)",
+        short(*.reach),
+        short(*.size)
+    )]
+    Unresolved { reach: f64, size: f64 },
 }
+
+/// The smallest block size, relative to its largest coordinate, that is simulated. Below it
+/// the hull's tolerance (1e-7 of the size) is under one unit in the last place of the
+/// coordinates (1.1e-16 of them), so flatness and contact could only be guessed.
+const RESOLUTION: f64 = 1e-9;
 
 /// An edge of a polyhedron with the two faces that meet along it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -50,10 +66,10 @@ pub struct MassProperties {
 /// Builds the convex hull of `points`: the extreme points, their faces (coplanar triangles merged
 /// into one polygon) and edges.
 ///
-/// Blocks have a handful to a few dozen vertices, so this enumerates candidate planes through
-/// point triples and keeps the supporting ones. That is O(n⁴) but exact about coplanar faces,
-/// which is what contact detection needs: a box must come out with six quadrilaterals, not twelve
-/// triangles whose diagonals would look like edges to the edge-to-edge test.
+/// Exact about coplanar faces, which is what contact detection needs: a box comes out with six
+/// quadrilaterals, not twelve triangles whose diagonals would look like edges to the
+/// edge-to-edge test. O(n log n) (see [`super::hull`]): a scanned boulder of 100 000 points
+/// takes a fraction of a second.
 pub fn convex_hull(points: &[Vec3]) -> Result<(Vec<Vec3>, Topology), GeometryError> {
     for (i, p) in points.iter().enumerate() {
         if !(p.x.is_finite() && p.y.is_finite() && p.z.is_finite()) {
@@ -68,81 +84,23 @@ pub fn convex_hull(points: &[Vec3]) -> Result<(Vec<Vec3>, Topology), GeometryErr
     if diag == 0.0 {
         return Err(GeometryError::Flat);
     }
+    let reach = points.iter().fold(0.0f64, |m, p| m.max(p.amax()));
+    let size = (hi - lo).max();
+    if size < RESOLUTION * reach {
+        return Err(GeometryError::Unresolved { reach, size });
+    }
     // Points closer than this to a plane are on it. Loose enough for coordinates typed with
     // four or five significant digits, tight enough to keep real faces apart.
     let tol = 1e-7 * diag;
-    let mut pts: Vec<Vec3> = Vec::new();
-    for p in points {
-        if pts.iter().all(|q| (q - p).norm() > tol) {
-            pts.push(*p);
-        }
-    }
+    let pts = hull::dedup(points, &lo, tol);
     let n = pts.len();
     if n < 4 {
         return Err(GeometryError::TooFewVertices(n));
     }
+    let mut faces = hull::faces(&pts, tol, diag)?;
 
-    // Supporting planes, each with the set of points lying on it.
-    let mut planes: Vec<(Vec3, Vec<usize>)> = Vec::new();
-    for i in 0..n {
-        for j in i + 1..n {
-            for k in j + 1..n {
-                if planes
-                    .iter()
-                    .any(|(_, on)| on.contains(&i) && on.contains(&j) && on.contains(&k))
-                {
-                    continue;
-                }
-                let nrm = (pts[j] - pts[i]).cross(&(pts[k] - pts[i]));
-                let len = nrm.norm();
-                if len <= tol * diag {
-                    continue; // collinear triple
-                }
-                let mut nrm = nrm / len;
-                let d = nrm.dot(&pts[i]);
-                let (mut above, mut below) = (false, false);
-                for p in &pts {
-                    let s = nrm.dot(p) - d;
-                    above |= s > tol;
-                    below |= s < -tol;
-                }
-                if above && below {
-                    continue;
-                }
-                if !above && !below {
-                    return Err(GeometryError::Flat);
-                }
-                if above {
-                    nrm = -nrm;
-                }
-                let on: Vec<usize> = (0..n)
-                    .filter(|&m| (nrm.dot(&pts[m]) - nrm.dot(&pts[i])).abs() <= tol)
-                    .collect();
-                planes.push((nrm, on));
-            }
-        }
-    }
-    if planes.len() < 4 {
-        return Err(GeometryError::Flat);
-    }
-
-    // Order each face counter-clockwise about its outward normal and drop points that are not
-    // corners (on an edge or inside the face): a 2-D convex hull in the face plane.
-    let mut faces: Vec<Vec<usize>> = Vec::with_capacity(planes.len());
-    for (nrm, on) in &planes {
-        let u = any_perpendicular(nrm);
-        let v = nrm.cross(&u);
-        let pts2: Vec<(f64, f64, usize)> = on
-            .iter()
-            .map(|&m| (pts[m].dot(&u), pts[m].dot(&v), m))
-            .collect();
-        let ring = convex_hull_2d(pts2, tol);
-        if ring.len() >= 3 {
-            faces.push(ring);
-        }
-    }
-
-    // Keep only the points that are corners of some face, and renumber.
+    // Keep only the points that are corners of some face, numbered in order of first
+    // appearance.
     let mut used = vec![usize::MAX; n];
     let mut vertices = Vec::new();
     for f in &faces {
@@ -162,43 +120,7 @@ pub fn convex_hull(points: &[Vec3]) -> Result<(Vec<Vec3>, Topology), GeometryErr
     Ok((vertices, topo))
 }
 
-/// Andrew's monotone chain; returns the labels of the corners in counter-clockwise order.
-fn convex_hull_2d(mut p: Vec<(f64, f64, usize)>, tol: f64) -> Vec<usize> {
-    p.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
-    let cross = |o: (f64, f64, usize), a: (f64, f64, usize), b: (f64, f64, usize)| {
-        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
-    };
-    // A turn counts as a corner only if the deviation is above tolerance (cross / length).
-    let turns_left = |o, a, b| {
-        let c = cross(o, a, b);
-        let (o, b): ((f64, f64, usize), (f64, f64, usize)) = (o, b);
-        let len = ((b.0 - o.0).powi(2) + (b.1 - o.1).powi(2)).sqrt();
-        c > tol * len
-    };
-    let mut hull: Vec<(f64, f64, usize)> = Vec::new();
-    // Lower chain left to right, then the upper chain right to left; the upper pass must not
-    // pop points of the lower chain.
-    for (pass, floor) in [(0, 2), (1, 0)] {
-        let floor = if pass == 0 { floor } else { hull.len() + 1 };
-        let seq: Box<dyn Iterator<Item = &(f64, f64, usize)>> = if pass == 0 {
-            Box::new(p.iter())
-        } else {
-            Box::new(p.iter().rev().skip(1))
-        };
-        for &q in seq {
-            while hull.len() >= floor.max(2)
-                && !turns_left(hull[hull.len() - 2], hull[hull.len() - 1], q)
-            {
-                hull.pop();
-            }
-            hull.push(q);
-        }
-    }
-    hull.pop();
-    hull.into_iter().map(|q| q.2).collect()
-}
-
-fn any_perpendicular(n: &Vec3) -> Vec3 {
+pub(super) fn any_perpendicular(n: &Vec3) -> Vec3 {
     let a = if n.x.abs() < 0.9 {
         Vec3::x()
     } else {
@@ -210,21 +132,27 @@ fn any_perpendicular(n: &Vec3) -> Vec3 {
 impl Topology {
     /// Derives edges and vertex adjacency from faces; fails unless every edge has two faces.
     pub fn from_faces(n_vertices: usize, faces: Vec<Vec<usize>>) -> Result<Self, GeometryError> {
-        let mut map: std::collections::BTreeMap<(usize, usize), Vec<usize>> = Default::default();
+        // Sorting (edge, face) keys rather than filling a map of vectors keeps this fast without
+        // an allocation per edge: a scanned block has hundreds of thousands of edges. A key is
+        // (low vertex, high vertex, face) in 32 bits each, compared as one number.
+        let mut sides: Vec<u128> = Vec::new();
         for (fi, f) in faces.iter().enumerate() {
             for k in 0..f.len() {
                 let (a, b) = (f[k], f[(k + 1) % f.len()]);
-                map.entry((a.min(b), a.max(b))).or_default().push(fi);
+                let key = [a.min(b), a.max(b), fi].map(|x| u128::from(x as u32));
+                sides.push(key[0] << 64 | key[1] << 32 | key[2]);
             }
         }
-        let mut edges = Vec::with_capacity(map.len());
-        for ((a, b), fs) in map {
-            if fs.len() != 2 {
+        sides.sort_unstable();
+        let mut edges = Vec::with_capacity(sides.len() / 2);
+        for run in sides.chunk_by(|x, y| x >> 32 == y >> 32) {
+            if run.len() != 2 {
                 return Err(GeometryError::NotClosed);
             }
+            let part = |x: u128, shift: u32| (x >> shift) as u32 as usize;
             edges.push(Edge {
-                v: [a, b],
-                faces: [fs[0], fs[1]],
+                v: [part(run[0], 64), part(run[0], 32)],
+                faces: [part(run[0], 0), part(run[1], 0)],
             });
         }
         // Euler's formula for a convex polyhedron: V − E + F = 2.

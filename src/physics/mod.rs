@@ -3,6 +3,8 @@
 //!
 //! - [`geometry`]: convex hulls, polyhedron integrals (volume, centroid, second moments), the
 //!   separating-axis overlap test, and the shapes a scene can name;
+//! - [`hull`]: the convex hull itself, O(n log n): quickhull on exact predicates, coplanar
+//!   triangles merged into faces;
 //! - [`mechanics`]: Shi's 12-DOF first-order displacement function and the block submatrices
 //!   (mass, elasticity, loads, fixed-point springs) of reference §1–3, and the finite-rotation
 //!   update (1.3);
@@ -11,6 +13,7 @@
 //! - [`linear`]: the block-sparse global matrix and its sparse Cholesky factorization.
 
 pub mod geometry;
+mod hull;
 pub mod integrator;
 pub mod linear;
 pub mod mechanics;
