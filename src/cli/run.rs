@@ -117,12 +117,6 @@ enum End {
     Io(OutputError),
 }
 
-impl From<OutputError> for End {
-    fn from(e: OutputError) -> Self {
-        End::Io(e)
-    }
-}
-
 /// The outputs of a run as it goes: rows every step, and at every [`CHECKPOINT`] both CSV
 /// files committed to the same step and summary.json rewritten as "running".
 struct Record<'a> {
