@@ -8,6 +8,7 @@
 //! line is a contract: flags, defaults, help texts and exit statuses stay as they are.
 
 mod bench;
+pub mod exit;
 mod generate;
 mod render;
 mod run;
@@ -144,16 +145,30 @@ pub fn dispatch(cli: &Cli) -> Result<(), CliError> {
 }
 
 /// The whole binary: parses the process's arguments, runs the subcommand and reports a failure
-/// as `error: …` on stderr. Call it first thing in `main`, before any other thread starts (it
-/// may set an environment variable).
+/// as one line on stderr with its exit status ([`exit`] has the table). Call it first thing in
+/// `main`, before any other thread starts (it may set an environment variable).
 pub fn main_entry() -> ExitCode {
     quiet_mesa_runtime_dir();
     let cli = Cli::parse_from(expand_scene_shorthand(std::env::args_os().collect()));
-    match dispatch(&cli) {
+    // `run` and `render` say which kind of failure ended them. Of the others, `generate` can
+    // only fail to write its file, the viewer's window or GPU can fail (a solver error stays in
+    // the window), and `bench` fails when one of its runs does.
+    let result = match &cli.command {
+        CliCommand::Run(args) => run::execute(args),
+        CliCommand::Render(args) => render::execute(args),
+        CliCommand::Generate(_) => {
+            dispatch(&cli).map_err(|e| exit::Failure::from_cli(e, exit::Failure::Io))
+        }
+        CliCommand::View(_) => {
+            dispatch(&cli).map_err(|e| exit::Failure::from_cli(e, exit::Failure::Failed))
+        }
+        CliCommand::Bench(_) => dispatch(&cli).map_err(exit::Failure::from),
+    };
+    match result {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {}", e.message());
-            ExitCode::from(u8::try_from(e.exit_code()).unwrap_or(1))
+        Err(f) => {
+            eprintln!("{}", f.line());
+            ExitCode::from(f.status().code())
         }
     }
 }

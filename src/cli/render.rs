@@ -6,13 +6,15 @@ use std::time::Instant;
 
 use clap::Args;
 
+use super::exit::{self, Failure, Signal};
 use super::{CliError, Progress, SolverOverrides, load_scene};
-use crate::output::slug;
+use crate::output::{slug, write_atomically};
 use crate::render::{
     ArrowMode, CameraOverride, CaptureOptions, CaptureReport, Coloring, FrameCapture, Framing,
     RenderError,
 };
 use crate::solver::{Solver, SolverError};
+use crate::text::short;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
@@ -67,13 +69,28 @@ struct Simulated {
     seconds: f64,
     /// The solver error that ended the run early, if any.
     failure: Option<SolverError>,
+    /// The stop signal that ended the run early, if any.
+    interrupted: Option<Signal>,
+}
+
+/// A capture failure with its exit status: a file that cannot be written is an I/O error, a
+/// missing GPU or bad options bad input, and the rest (the device, a worker) a failure of
+/// neither.
+fn capture_failure(out: &Path, e: RenderError) -> Failure {
+    match e {
+        RenderError::NoAdapter | RenderError::InvalidOptions(_) => Failure::Input(e.to_string()),
+        // The encoders' errors are the PNG writer's, that is the file's.
+        RenderError::Io { .. } | RenderError::Encode(_) => Failure::Io(e.to_string()),
+        other => Failure::Failed(format!("{}: {other}", out.display())),
+    }
 }
 
 /// `dda3d render`: the solver runs on this thread and hands a snapshot to the capture pipeline
 /// (its own render thread and PNG encoder threads) at every frame time, so rendering and encoding
 /// overlap with the simulation. Frames come from the solver's own steps, which are shortened to
-/// land exactly on the frame times, not from re-simulation.
-pub fn render(args: &RenderArgs) -> Result<(), CliError> {
+/// land exactly on the frame times, not from re-simulation. SIGINT or SIGTERM ends the
+/// simulation after its step; the frames already handed over are still written.
+pub(super) fn execute(args: &RenderArgs) -> Result<(), Failure> {
     let scene = load_scene(&args.scene, &args.overrides)?;
     check_image_options(args)?;
     let out = args
@@ -83,39 +100,51 @@ pub fn render(args: &RenderArgs) -> Result<(), CliError> {
     let opts = capture_options(args, &out)?;
     let name = scene.name.clone();
     let mut solver = Solver::new(scene.model, scene.params);
-    let capture = FrameCapture::start(opts).map_err(|e| match e {
-        RenderError::NoAdapter | RenderError::InvalidOptions(_) => CliError::Input(e.to_string()),
-        other => CliError::Run(other.to_string()),
-    })?;
-    let render_err = |e: RenderError| CliError::Run(format!("{}: {e}", out.display()));
+    exit::catch_stop_signals()?;
+    let capture = FrameCapture::start(opts).map_err(|e| capture_failure(&out, e))?;
     let start = Instant::now();
-    let simulated = simulate_frames(&mut solver, &capture, args).map_err(render_err)?;
-    let report = capture.finish().map_err(render_err)?;
+    let simulated =
+        simulate_frames(&mut solver, &capture, args).map_err(|e| capture_failure(&out, e))?;
+    let report = capture.finish().map_err(|e| capture_failure(&out, e))?;
     let wall = start.elapsed().as_secs_f64();
     write_summary(&out, &name, args, &report, &simulated, wall)?;
+    let reached = format!(
+        "{} frames up to t = {} s are in {}",
+        report.frames,
+        short(solver.time),
+        out.display()
+    );
     if let Some(e) = simulated.failure {
-        return Err(CliError::Run(format!(
-            "{}: {e}; {} frames up to t = {:.6} s are in {}",
-            args.scene.display(),
-            report.frames,
-            solver.time,
-            out.display()
+        return Err(Failure::Diverged(format!(
+            "{}: {e}; {reached}",
+            args.scene.display()
         )));
+    }
+    if let Some(signal) = simulated.interrupted {
+        return Err(Failure::Interrupted(
+            signal,
+            format!("{}; {reached}", signal.name()),
+        ));
     }
     if !args.quiet {
         eprintln!(
-            "{name}: {} frames in {:.2} s ({:.1} frames/s; simulation {:.2} s, render+readback {:.1} ms/frame, PNG {:.1} ms/frame on {}); frames in {}",
+            "{name}: {} frames in {} s ({} frames/s; simulation {} s, render+readback {} ms/frame, PNG {} ms/frame on {}); frames in {}",
             report.frames,
-            wall,
-            report.frames as f64 / wall,
-            simulated.seconds,
-            report.render_ms_per_frame(),
-            report.encode_ms_per_frame(),
+            short(wall),
+            short(report.frames as f64 / wall),
+            short(simulated.seconds),
+            short(report.render_ms_per_frame()),
+            short(report.encode_ms_per_frame()),
             report.adapter,
             out.display()
         );
     }
     Ok(())
+}
+
+/// `dda3d render`.
+pub fn render(args: &RenderArgs) -> Result<(), CliError> {
+    execute(args).map_err(CliError::from)
 }
 
 /// The checks of `--fps`, `--width`/`--height` and `--msaa` that need no GPU.
@@ -194,10 +223,15 @@ fn simulate_frames(
     let total_frames = (solver.params.duration * args.fps + 1e-9).floor() as u64 + 1;
     let mut progress = Progress::new(solver.params.duration, args.quiet);
     capture.submit(solver.snapshot())?;
-    let mut failure = None;
+    let (mut failure, mut interrupted) = (None, None);
     'frames: for k in 1..total_frames {
         let t = k as f64 * frame_dt;
         while solver.time < t - 1e-9 * frame_dt {
+            // Between steps: a frame cut short is not submitted.
+            interrupted = exit::interrupted();
+            if interrupted.is_some() {
+                break 'frames;
+            }
             let ts = Instant::now();
             let r = solver.step_until(t);
             seconds += ts.elapsed().as_secs_f64();
@@ -210,10 +244,15 @@ fn simulate_frames(
         progress.update(solver.time);
     }
     progress.finish();
-    Ok(Simulated { seconds, failure })
+    Ok(Simulated {
+        seconds,
+        failure,
+        interrupted,
+    })
 }
 
-/// Writes render_summary.json: frame count, size, adapter and where the time went.
+/// Writes render_summary.json (atomically): frame count, size, adapter, where the time went,
+/// and how the run ended.
 fn write_summary(
     out: &Path,
     name: &str,
@@ -221,7 +260,14 @@ fn write_summary(
     report: &CaptureReport,
     simulated: &Simulated,
     wall: f64,
-) -> Result<(), CliError> {
+) -> Result<(), Failure> {
+    let status = if simulated.failure.is_some() {
+        "diverged"
+    } else if simulated.interrupted.is_some() {
+        "interrupted"
+    } else {
+        "completed"
+    };
     let summary = serde_json::json!({
         "scene": name,
         "frames": report.frames,
@@ -237,11 +283,10 @@ fn write_summary(
         "png_encode_seconds": report.encode_seconds,
         "gif_seconds": report.gif_seconds,
         "setup_seconds": report.setup_seconds,
-        "status": if simulated.failure.is_some() { "diverged" } else { "completed" },
+        "status": status,
     });
-    std::fs::write(
-        out.join("render_summary.json"),
-        serde_json::to_string_pretty(&summary).unwrap_or_default(),
-    )
-    .map_err(|e| CliError::Run(format!("{}: {e}", out.display())))
+    let path = out.join("render_summary.json");
+    let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
+    write_atomically(&path, text.as_bytes())
+        .map_err(|e| Failure::Io(format!("{}: cannot write: {e}", path.display())))
 }

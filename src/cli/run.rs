@@ -1,5 +1,7 @@
 //! `dda3d run`: simulates a scene headless and writes blocks.csv, contacts.csv and summary.json,
-//! with a progress bar for long runs (also used by `dda3d render`).
+//! with a progress bar for long runs (also used by `dda3d render`). A run stopped by SIGINT or
+//! SIGTERM finishes its step and writes everything; a checkpoint every second keeps the files
+//! usable even after a kill -9 (see [`crate::output`]).
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -7,9 +9,12 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use super::exit::{self, Failure, Signal};
 use super::{CliError, SolverOverrides, load_scene};
-use crate::output::{RunWriter, Summary, slug};
+use crate::output::{OutputError, RunWriter, Summary, slug};
+use crate::params::{Method, Mode};
 use crate::solver::{Solver, SolverError};
+use crate::text::short;
 
 #[derive(Args, Debug)]
 pub struct RunArgs {
@@ -72,88 +77,212 @@ impl Progress {
 
 /// Runs the initial equilibrium stage, if the scene has one, and says how it ended: an
 /// unconverged stage is a warning (a block the stage could not bring to rest), not an error.
-fn settle(solver: &mut Solver, scene: &Path, quiet: bool) -> Result<(), SolverError> {
+/// A stop signal ends the stage early (`Ok(Some(signal))`).
+fn settle(solver: &mut Solver, scene: &Path, quiet: bool) -> Result<Option<Signal>, SolverError> {
     while solver.in_equilibrium_stage() {
+        if let Some(signal) = exit::interrupted() {
+            return Ok(Some(signal));
+        }
         solver.step()?;
     }
     match solver.equilibrium() {
         Some(r) if !r.converged => eprintln!(
-            "{}: warning: the initial equilibrium stage did not converge: R_max = {:.2e} after {} \
-             steps (tolerance {:.0e}); a block may be unstable under gravity, or raise \
+            "{}: warning: the initial equilibrium stage did not converge: R_max = {} after {} \
+             steps (tolerance {}); a block may be unstable under gravity, or raise \
              equilibrium_max_steps",
             scene.display(),
-            r.residual,
+            short(r.residual),
             r.steps,
-            r.tolerance
+            short(r.tolerance)
         ),
         Some(r) if !quiet => eprintln!(
-            "initial equilibrium: R_max = {:.2e} after {} static steps",
-            r.residual, r.steps
+            "initial equilibrium: R_max = {} after {} static steps",
+            short(r.residual),
+            r.steps
         ),
         _ => {}
     }
-    Ok(())
+    Ok(None)
 }
 
-/// `dda3d run`.
-pub fn run(args: &RunArgs) -> Result<(), CliError> {
+/// How often, in wall time, a run commits its CSV rows and rewrites summary.json as
+/// "running": what a kill -9 can lose.
+const CHECKPOINT: Duration = Duration::from_secs(1);
+
+/// How a run ended.
+enum End {
+    Completed,
+    Diverged(SolverError),
+    Interrupted(Signal),
+    Io(OutputError),
+}
+
+/// The outputs of a run as it goes: rows every step, and at every [`CHECKPOINT`] both CSV
+/// files committed to the same step and summary.json rewritten as "running".
+struct Record<'a> {
+    writer: RunWriter,
+    scene: &'a str,
+    method: Method,
+    mode: Mode,
+    start: Instant,
+    last_checkpoint: Instant,
+}
+
+impl Record<'_> {
+    fn summary(&self, solver: &Solver, status: &str) -> Summary {
+        let wall = self.start.elapsed().as_secs_f64();
+        let (method, mode) = (self.method.as_str(), self.mode.as_str());
+        let mut s = Summary::new(self.scene, method, mode, solver.time, wall, &solver.totals);
+        s.status = status.into();
+        s.written_time = self.writer.written_time();
+        s.equilibrium = solver.equilibrium();
+        s
+    }
+
+    /// Rows of the step just completed, and a checkpoint when one is due.
+    fn step(&mut self, solver: &Solver) -> Result<(), OutputError> {
+        self.writer.write(&solver.snapshot())?;
+        if self.last_checkpoint.elapsed() >= CHECKPOINT {
+            self.checkpoint(solver)?;
+        }
+        Ok(())
+    }
+
+    fn checkpoint(&mut self, solver: &Solver) -> Result<(), OutputError> {
+        self.writer.commit()?;
+        self.summary(solver, "running").write(self.writer.dir())?;
+        self.last_checkpoint = Instant::now();
+        Ok(())
+    }
+
+    /// The final summary.json (the rows are committed by then).
+    fn finish(&mut self, solver: &Solver, end: &End) -> Result<(), OutputError> {
+        let (status, error) = match end {
+            End::Completed => ("completed", None),
+            End::Diverged(e) => ("diverged", Some(e.to_string())),
+            End::Interrupted(s) => ("interrupted", Some(format!("stopped by {}", s.name()))),
+            End::Io(e) => ("io_error", Some(e.to_string())),
+        };
+        let mut summary = self.summary(solver, status);
+        summary.error = error;
+        summary.write(self.writer.dir()).map(|_| ())
+    }
+}
+
+/// Steps the run to its end, a divergence, a stop signal or a failed write. A signal that
+/// arrives during a step lets the step finish and its rows be written.
+fn advance(solver: &mut Solver, rec: &mut Record, args: &RunArgs) -> End {
+    let mut progress = Progress::new(solver.params.duration, args.quiet);
+    let end = (|| {
+        // A first summary.json at once, so even a run killed in its first second says so.
+        rec.checkpoint(solver)?;
+        let settled = settle(solver, &args.scene, args.quiet);
+        if let Ok(Some(signal)) = settled {
+            return Ok(End::Interrupted(signal));
+        }
+        // A failed equilibrium stage still writes the state it reached, as a diverged step does.
+        rec.writer.write(&solver.snapshot())?;
+        if let Err(e) = settled {
+            return Ok(End::Diverged(e));
+        }
+        while !solver.finished() {
+            if let Some(signal) = exit::interrupted() {
+                return Ok(End::Interrupted(signal));
+            }
+            if let Err(e) = solver.step() {
+                return Ok(End::Diverged(e));
+            }
+            rec.step(solver)?;
+            progress.update(solver.time);
+        }
+        Ok::<End, OutputError>(End::Completed)
+    })();
+    progress.finish();
+    end.unwrap_or_else(End::Io)
+}
+
+/// `dda3d run`, with its failures as [`Failure`]s (their exit statuses). Bad input is
+/// reported before any file is created.
+pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
     let scene = load_scene(&args.scene, &args.overrides)?;
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)));
-    let io = |e: std::io::Error| CliError::Run(format!("{}: {e}", out.display()));
-    let mut writer = RunWriter::create(&out).map_err(io)?;
+    exit::catch_stop_signals()?;
+    let writer = RunWriter::create(&out).map_err(|e| Failure::Io(e.to_string()))?;
     let name = scene.name.clone();
-    let (method, mode) = (scene.params.method, scene.params.mode);
+    let mut rec = Record {
+        writer,
+        scene: &name,
+        method: scene.params.method,
+        mode: scene.params.mode,
+        start: Instant::now(),
+        last_checkpoint: Instant::now(),
+    };
     let mut solver = Solver::new(scene.model, scene.params);
-    let start = Instant::now();
-    let mut progress = Progress::new(solver.params.duration, args.quiet);
-    let mut failure = settle(&mut solver, &args.scene, args.quiet).err();
-    writer.write(&solver.snapshot()).map_err(io)?;
-    while failure.is_none() && !solver.finished() {
-        if let Err(e) = solver.step() {
-            failure = Some(e);
-            break;
+    let mut end = advance(&mut solver, &mut rec, args);
+    if !matches!(end, End::Io(_)) {
+        // The last rows. If they cannot be written, that is what the summary reports: the
+        // files stop short of the state the run reached.
+        if let Err(e) = rec.writer.commit() {
+            end = End::Io(e);
         }
-        writer.write(&solver.snapshot()).map_err(io)?;
-        progress.update(solver.time);
     }
-    progress.finish();
-    writer.flush().map_err(io)?;
-    let wall = start.elapsed().as_secs_f64();
-    let mut summary = Summary::new(
-        &name,
-        method.as_str(),
-        mode.as_str(),
-        solver.time,
-        wall,
-        &solver.totals,
-    );
-    summary.equilibrium = solver.equilibrium();
-    if let Some(e) = &failure {
-        summary.status = "diverged".into();
-        summary.error = Some(e.to_string());
-    }
-    summary.write(&out).map_err(io)?;
-    if let Some(e) = failure {
-        return Err(CliError::Run(format!(
-            "{}: {e}; results up to t = {:.6} s are in {}",
+    let saved = rec.finish(&solver, &end);
+    report(&solver, &rec, end, saved, args)
+}
+
+/// The outcome as one line on stderr (or none) and an exit status.
+fn report(
+    solver: &Solver,
+    rec: &Record,
+    end: End,
+    saved: Result<(), OutputError>,
+    args: &RunArgs,
+) -> Result<(), Failure> {
+    let out = rec.writer.dir().display();
+    let kept = match rec.writer.written_time() {
+        Some(t) => format!("complete rows up to t = {} s are in {out}", short(t)),
+        None => format!("no rows were written to {out}"),
+    };
+    match (end, saved) {
+        (End::Io(e), saved) => {
+            let also = saved.err().map(|s| format!("; {s}")).unwrap_or_default();
+            Err(Failure::Io(format!("{e}; {kept}{also}")))
+        }
+        (_, Err(e)) => Err(Failure::Io(format!("{e}; {kept}"))),
+        (End::Diverged(e), Ok(())) => Err(Failure::Diverged(format!(
+            "{}: {e}; results up to t = {} s are in {out}",
             args.scene.display(),
-            solver.time,
-            out.display()
-        )));
+            short(solver.time)
+        ))),
+        (End::Interrupted(signal), Ok(())) => Err(Failure::Interrupted(
+            signal,
+            format!(
+                "{} at t = {} s after {} steps; {kept}",
+                signal.name(),
+                short(solver.time),
+                solver.totals.steps
+            ),
+        )),
+        (End::Completed, Ok(())) => {
+            if !args.quiet {
+                eprintln!(
+                    "{}: {} steps to t = {} s in {} s wall; max penetration {} m; results in {out}",
+                    rec.scene,
+                    solver.totals.steps,
+                    short(solver.time),
+                    short(rec.start.elapsed().as_secs_f64()),
+                    short(solver.totals.max_penetration),
+                );
+            }
+            Ok(())
+        }
     }
-    if !args.quiet {
-        eprintln!(
-            "{}: {} steps to t = {:.3} s in {:.2} s wall; max penetration {:.3e} m; results in {}",
-            name,
-            solver.totals.steps,
-            solver.time,
-            wall,
-            solver.totals.max_penetration,
-            out.display()
-        );
-    }
-    Ok(())
+}
+
+/// `dda3d run`.
+pub fn run(args: &RunArgs) -> Result<(), CliError> {
+    execute(args).map_err(CliError::from)
 }

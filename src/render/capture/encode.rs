@@ -67,6 +67,26 @@ pub fn write_png(
             rgba.len()
         )));
     }
+    // Written beside its final name and renamed when whole, so a run that is stopped or runs
+    // out of disk never leaves a truncated PNG under a frame's name.
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    let written = encode_png(&tmp, rgba, width, height, transparent)
+        .and_then(|_| std::fs::rename(&tmp, path).map_err(|e| RenderError::io(path, e)));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
+}
+
+fn encode_png(
+    path: &Path,
+    rgba: &[u8],
+    width: u32,
+    height: u32,
+    transparent: bool,
+) -> Result<(), RenderError> {
     let file = File::create(path).map_err(|e| RenderError::io(path, e))?;
     let mut out = BufWriter::new(file);
     let encoder = image::codecs::png::PngEncoder::new(&mut out);
