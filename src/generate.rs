@@ -3,6 +3,14 @@
 
 use std::fmt::Write;
 
+/// The most wall blocks a generated scene may have: with the ground slab and the rock, a scene
+/// of at most [`crate::scene::MAX_BLOCKS`] blocks, so that every generated scene loads.
+pub const MAX_WALL_BLOCKS: usize = crate::scene::MAX_BLOCKS - 2;
+
+/// Δt_max of the generated scenes, s (the paper's): what a scaling run's duration is checked
+/// against (the steps it may take).
+pub const MAX_TIME_STEP: f64 = 0.01;
+
 /// A wall of `blocks` jointed blocks (1.2 m × 1.2 m × 2.0 m, as in the rockfall scene), stacked
 /// `layers` high in columns standing side by side along y, the bottom layer fixed, struck at
 /// mid-length by a dodecahedral rock thrown at 10 m/s. `blocks = 5, layers = 5` is the paper's
@@ -38,7 +46,7 @@ pub fn column_wall(blocks: usize, layers: usize, rock: bool) -> String {
     );
     let _ = writeln!(
         s,
-        "[solver]\nmethod = \"alm\"\nmode = \"dynamic\"\nduration = 2.0\nmax_time_step = 0.01\n\
+        "[solver]\nmethod = \"alm\"\nmode = \"dynamic\"\nduration = 2.0\nmax_time_step = {MAX_TIME_STEP}\n\
          max_displacement_ratio = {delta:.6e}\ngravity = [0.0, 0.0, -9.8]\n"
     );
     let _ = writeln!(

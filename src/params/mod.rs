@@ -8,6 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod numbers;
 pub mod table;
 
 /// Shi's step-control rules (reference §6.3, §8). They are part of the method, not tunables; the
@@ -188,6 +189,7 @@ pub struct SolverParams {
     /// largest extent of the model's bounding box).
     pub max_displacement_ratio: f64,
     /// Gravity, m/s²; z is up.
+    #[serde(deserialize_with = "numbers::exact")]
     pub gravity: [f64; 3],
     /// Stiffness of the vertex springs of fixed blocks, as a multiple of the block's E
     /// (the paper uses 100 E).
@@ -235,18 +237,41 @@ impl Default for SolverParams {
     }
 }
 
+/// A value [`SolverParams::check`] rejects: the message, and the scene-file keys it concerns,
+/// the one to point at first (the message's line, the flag that set it) first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Invalid {
+    pub keys: &'static [&'static str],
+    pub message: String,
+}
+
 impl SolverParams {
-    /// Checks every value against the range of its [`table`] entry; returns a message naming the
-    /// offending key. Every number is first checked to be finite, then each against its range,
-    /// both in the table's (the scene file's) order.
+    /// Checks every value against the range of its [`table`] entry, then the number of steps the
+    /// run would take ([`table::MAX_STEPS`]); returns a message naming the offending key. Every
+    /// number is first checked to be finite, then each against its range, both in the table's
+    /// (the scene file's) order.
     pub fn validate(&self) -> Result<(), String> {
+        self.check().map_err(|e| e.message)
+    }
+
+    /// [`SolverParams::validate`], with the keys the failure concerns.
+    pub fn check(&self) -> Result<(), Invalid> {
+        let invalid = |p: &'static table::Param| {
+            move |message| Invalid {
+                keys: std::slice::from_ref(&p.key),
+                message,
+            }
+        };
         for p in table::ALL {
-            p.check_finite(self)?;
+            p.check_finite(self).map_err(invalid(p))?;
         }
         for p in table::ALL {
-            p.check_range(self)?;
+            p.check_range(self).map_err(invalid(p))?;
         }
-        Ok(())
+        table::check_steps(self).map_err(|message| Invalid {
+            keys: &[table::DURATION.key, table::MAX_TIME_STEP.key],
+            message,
+        })
     }
 }
 

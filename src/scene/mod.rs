@@ -21,15 +21,34 @@
 
 mod build;
 mod format;
+mod locate;
 
 use std::fmt;
+use std::io::Read;
 use std::path::Path;
 
 use build::{build_block, check_material, check_overlaps};
 use format::SceneFile;
+use locate::{key_at, key_line, line_of};
 
 use crate::model::Model;
 use crate::params::SolverParams;
+use crate::text::short;
+
+/// The largest scene file read, in bytes (64 MiB). The largest scenes the other limits allow
+/// take a few tens of MiB: 100 000 boxes are 11 MiB, 100 000 blocks of 8 explicit vertices some
+/// 30 MiB. toml keeps a parsed copy of some ten times the text's size, so a bound here is a
+/// bound on memory; `run /dev/zero` read until memory ran out.
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
+/// The most blocks a scene may have. The solver's cost grows about linearly with the blocks
+/// (README, Performance: a wall of 1000 blocks runs in minutes), so 10⁵ is already a long run;
+/// `dda3d generate` writes walls up to this size.
+pub const MAX_BLOCKS: usize = 100_000;
+
+/// The most points a block's shape may have (`vertices`, or twice a prism's base): the convex
+/// hull of 10⁵ points takes well under a second in O(n log n), and a real block has tens.
+pub const MAX_BLOCK_POINTS: usize = 100_000;
 
 /// A bad scene: one line naming the file, the line when known, and the problem.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,11 +60,29 @@ pub struct SceneError {
 
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}: line {}: {}", self.path, l, self.message),
-            None => write!(f, "{}: {}", self.path, self.message),
-        }
+        let text = match self.line {
+            Some(l) => format!("{}: line {}: {}", self.path, l, self.message),
+            None => format!("{}: {}", self.path, self.message),
+        };
+        // One line, whatever a name or a path in it holds (a block named "a\nb").
+        f.write_str(&one_line(&text))
     }
+}
+
+/// Control characters (a newline in a name, say) written as escapes.
+fn one_line(text: &str) -> String {
+    if !text.chars().any(char::is_control) {
+        return text.to_string();
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 impl std::error::Error for SceneError {}
@@ -61,10 +98,27 @@ pub struct Scene {
 /// Reads and validates a scene file.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+    let err = |line: Option<usize>, message: String| SceneError {
         path: shown.clone(),
-        line: None,
-        message: format!("cannot read: {e}"),
+        line,
+        message,
+    };
+    let bytes = read_bounded(path).map_err(|m| err(None, m))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let bad = e.utf8_error().valid_up_to();
+        let line_start = bytes[..bad]
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |k| k + 1);
+        err(
+            Some(bytes[..bad].iter().filter(|&&b| b == b'\n').count() + 1),
+            format!(
+                "not UTF-8 text: byte 0x{:02x} at column {} (a scene file is TOML, which is UTF-8)",
+                bytes[bad],
+                bad - line_start + 1
+            ),
+        )
     })?;
     let default_name = path
         .file_stem()
@@ -73,8 +127,56 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     parse(&text, &shown, &default_name)
 }
 
-fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].matches('\n').count() + 1
+/// The file's bytes, at most [`MAX_FILE_BYTES`] of them. A regular file says its size up front;
+/// a device, pipe or terminal (`/dev/zero`) does not, and is read up to the limit.
+fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
+    let cannot = |e: std::io::Error| format!("cannot read: {e}");
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let too_large = |size: &str| {
+        format!(
+            "{size}, more than the limit of {} MiB for a scene file",
+            MAX_FILE_BYTES >> 20
+        )
+    };
+    if let Ok(meta) = file.metadata()
+        && meta.is_file()
+        && meta.len() > MAX_FILE_BYTES
+    {
+        return Err(too_large(&format!(
+            "the file is {} MiB",
+            short(meta.len() as f64 / f64::from(1 << 20))
+        )));
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(too_large("the input goes on"));
+    }
+    Ok(bytes)
+}
+
+/// The line and message of a toml error: its line from its offset, and the key of the value it
+/// rejects where the message does not name it (`solver.gravity: expected 3 numbers, got 4`).
+fn toml_error(text: &str, e: &toml::de::Error) -> (Option<usize>, String) {
+    let message = e.message().trim().replace('\n', " ");
+    let Some(span) = e.span() else {
+        return (None, message);
+    };
+    let line = Some(line_of(text, span.start));
+    match key_at(text, span.start) {
+        Some(key) if !message.contains(&format!("`{key}`")) => (line, format!("{key}: {message}")),
+        _ => (line, message),
+    }
+}
+
+/// The line of the first of `keys` (`solver.contact.beta`) that the text sets.
+fn first_key_line(text: &str, keys: &[&str]) -> Option<usize> {
+    keys.iter().find_map(|k| {
+        let path: Vec<&str> = k.split('.').collect();
+        key_line(text, &path)
+    })
 }
 
 /// Parses scene text; `path` is used in messages only.
@@ -85,21 +187,35 @@ pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneE
         message,
     };
     let file: SceneFile = toml::from_str(text).map_err(|e| {
-        let line = e.span().map(|s| line_of(text, s.start));
-        err(line, e.message().trim().replace('\n', " "))
+        let (line, message) = toml_error(text, &e);
+        err(line, message)
     })?;
     let mut params = file.solver;
     params.joint = file.joint;
-    params.validate().map_err(|m| err(None, m))?;
+    params
+        .check()
+        .map_err(|e| err(first_key_line(text, e.keys), e.message))?;
 
     for (name, m) in &file.materials {
-        check_material(name, m.get_ref())
-            .map_err(|e| err(Some(line_of(text, m.span().start)), e))?;
+        check_material(name, m.get_ref()).map_err(|(key, e)| {
+            let line = key_line(text, &["materials", name, key])
+                .unwrap_or_else(|| line_of(text, m.span().start));
+            err(Some(line), e)
+        })?;
     }
     if file.blocks.is_empty() {
         return Err(err(
             None,
             "no [[blocks]]: a scene needs at least one block".into(),
+        ));
+    }
+    if let Some(extra) = file.blocks.get(MAX_BLOCKS) {
+        return Err(err(
+            Some(line_of(text, extra.span().start)),
+            format!(
+                "{} blocks, more than the limit of {MAX_BLOCKS} for a scene",
+                file.blocks.len()
+            ),
         ));
     }
 
@@ -123,8 +239,10 @@ pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneE
         blocks.push(build_block(spec, name.clone(), material).map_err(berr)?);
         lines.push(line);
     }
+    // A set, not a scan of the blocks before each: 10⁵ blocks are 5·10⁹ comparisons.
+    let mut names = std::collections::HashSet::with_capacity(blocks.len());
     for (k, b) in blocks.iter().enumerate() {
-        if blocks[..k].iter().any(|o| o.name == b.name) {
+        if !names.insert(b.name.as_str()) {
             return Err(err(
                 lines[k],
                 format!("block name '{}' is used twice", b.name),
