@@ -8,8 +8,8 @@
 use std::fmt;
 use std::marker::PhantomData;
 
-use serde::de::{self, Deserializer, IgnoredAny, SeqAccess, Visitor};
 use serde::Deserialize;
+use serde::de::{self, Deserializer, IgnoredAny, SeqAccess, Visitor};
 
 /// `N` numbers, no more and no fewer: for a list of points (`vertices = [[x, y, z], ...]`),
 /// where `deserialize_with` cannot reach the elements.

@@ -244,9 +244,16 @@ impl Param {
         if self.valid.contains(v) {
             return Ok(());
         }
-        // Short, unless rounding to four digits would show a value that lies inside the range
-        // (1.000000001 for a bound of 1).
-        if shown.parse().is_ok_and(|r: f64| self.valid.contains(r)) {
+        // Short, unless rounding to four digits would show a value inside the range or on one
+        // of its ends (1.000000001 as 1, for a range that ends at 1).
+        let ends = [self.valid.lo, self.valid.hi].map(|b| match b {
+            Bound::Open(x) | Bound::Closed(x) => x,
+            Bound::Unbounded => f64::NAN,
+        });
+        if shown
+            .parse()
+            .is_ok_and(|r: f64| r != v && (self.valid.contains(r) || ends.contains(&r)))
+        {
             shown = format!("{v:?}");
         }
         Err(format!(

@@ -35,11 +35,11 @@ use crate::model::Model;
 use crate::params::SolverParams;
 use crate::text::short;
 
-/// The largest scene file read, in bytes (64 MiB). The largest scenes the other limits allow
-/// take a few tens of MiB: 100 000 boxes are 11 MiB, 100 000 blocks of 8 explicit vertices some
-/// 30 MiB. toml keeps a parsed copy of some ten times the text's size, so a bound here is a
-/// bound on memory; `run /dev/zero` read until memory ran out.
-pub const MAX_FILE_BYTES: u64 = 64 << 20;
+/// The largest scene file read, in bytes (16 MiB). The largest generated wall (99 998 blocks)
+/// takes 12.8 MB. toml's parse keeps every number with its place in the text, so the memory of a
+/// parse grows with the text: 55 times a file of boxes, and 88 times (1.4 GB, some 15 s) a file
+/// of nothing but `[0,0,0],`. `run /dev/zero` read until memory ran out.
+pub const MAX_FILE_BYTES: u64 = 16 << 20;
 
 /// The most blocks a scene may have. The solver's cost grows about linearly with the blocks
 /// (README, Performance: a wall of 1000 blocks runs in minutes), so 10⁵ is already a long run;

@@ -68,8 +68,8 @@ pub const EPS1: Param = Param {
     default: Value::Real(0.01),
     get: |p| Value::Real(p.contact.eps1),
     valid: Interval::new(Bound::Open(0.0), Bound::Open(1.0)),
-    valid_why: "ε1 ≥ 1 would accept a penetration as deep as the whole contact window d_n,max, beyond \
-          which a contact is not found at all.",
+    valid_why: "ε1 ≥ 1 would accept a penetration as deep as the whole contact window d_n,max, \
+          beyond which a contact is not found at all.",
     widget: absolute(1e-4, 0.5, true),
 };
 
@@ -110,8 +110,8 @@ pub const MAX_ALM_ITERATIONS: Param = Param {
     default: Value::Count(20),
     get: |p| Value::Count(p.contact.max_alm_iterations),
     valid: Interval::new(Bound::Closed(1.0), Bound::Closed(1000.0)),
-    valid_why: "each iteration is a linear solve and the paper's ALM converges in a few; the cap bounds \
-          the cost of a pass that does not converge.",
+    valid_why: "each iteration is a linear solve and the paper's ALM converges in a few; the cap \
+          bounds the cost of a pass that does not converge.",
     widget: absolute(1.0, 100.0, false),
 };
 
@@ -125,8 +125,8 @@ pub const MAX_OPEN_CLOSE_ITERATIONS: Param = Param {
     default: Value::Count(30),
     get: |p| Value::Count(p.contact.max_open_close_iterations),
     valid: Interval::new(Bound::Closed(1.0), Bound::Closed(1000.0)),
-    valid_why: "each pass solves at least once; Shi uses 8, a struck wall 25, and a step still changing \
-          after 1000 is redone with a shorter Δt anyway.",
+    valid_why: "each pass solves at least once; Shi uses 8, a struck wall 25, and a step still \
+          changing after 1000 is redone with a shorter Δt anyway.",
     widget: absolute(1.0, 50.0, false),
 };
 
@@ -152,8 +152,8 @@ pub const CLOSE_THRESHOLD: Param = Param {
     default: Value::Real(2.0e-7),
     get: |p| Value::Real(p.contact.close_threshold),
     valid: Interval::new(Bound::Closed(0.0), Bound::Closed(0.01)),
-    valid_why: "Shi's s0 is 2·10⁻⁴; at 0.01 (the paper's δ) a contact would move as far as a whole \
-          step may before its state changes.",
+    valid_why: "Shi's s0 is 2·10⁻⁴; at 0.01 (the paper's δ) a contact would move as far as a \
+          whole step may before its state changes.",
     widget: None,
 };
 
@@ -167,8 +167,8 @@ pub const OPEN_THRESHOLD: Param = Param {
     default: Value::Real(2.0e-7),
     get: |p| Value::Real(p.contact.open_threshold),
     valid: Interval::new(Bound::Closed(0.0), Bound::Closed(0.01)),
-    valid_why: "Shi's s0 is 2·10⁻⁴; at 0.01 (the paper's δ) a contact would move as far as a whole \
-          step may before its state changes.",
+    valid_why: "Shi's s0 is 2·10⁻⁴; at 0.01 (the paper's δ) a contact would move as far as a \
+          whole step may before its state changes.",
     widget: None,
 };
 

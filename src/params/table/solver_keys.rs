@@ -58,9 +58,10 @@ pub const DURATION: Param = Param {
     default: Value::Real(2.0),
     get: |p| Value::Real(p.duration),
     valid: Interval::new(Bound::Closed(1e-7), Bound::Closed(1e7)),
-    valid_why: "at least the shortest Δt_max, so that every run takes a step (a run shorter than \
-          10⁻⁹·Δt_max ends before its first); at most the step limit of 10⁷ times the longest \
-          Δt_max. Within it, duration / Δt_max must stay at most 10⁷ steps.",
+    valid_why: "at least the shortest Δt_max, so that every run takes a step (the solver counts a \
+          run within 10⁻⁹·Δt_max of its end as finished: 10⁻¹² s \"completed\"with none); at most \
+          10⁷ steps of the longest Δt_max. Within it, duration / Δt_max must stay at most 10⁷ \
+          steps.",
     widget: absolute(1e-3, 1e6, false),
 };
 
@@ -73,10 +74,10 @@ pub const MAX_TIME_STEP: Param = Param {
     default: Value::Real(0.01),
     get: |p| Value::Real(p.max_time_step),
     valid: Interval::new(Bound::Closed(1e-7), Bound::Closed(1.0)),
-    valid_why: "a P-wave crosses a millimetre of rock in 2·10⁻⁷ s, and the constant-strain blocks of \
-          DDA resolve nothing faster; the step control cuts down to Δt_max / 100, which up to 1 s \
-          still reaches the paper's 0.01 s (above it, a model that moves at all diverges at the \
-          floor).",
+    valid_why: "a P-wave crosses a millimetre of rock in 2·10⁻⁷ s, and the constant-strain blocks \
+          of DDA resolve nothing faster; the step control cuts down to Δt_max / 100, which up to \
+          1 s still reaches the paper's 0.01 s (above it, a model that moves at all diverges at \
+          the floor).",
     widget: absolute(1e-5, 0.1, true),
 };
 
@@ -90,10 +91,10 @@ pub const MAX_DISPLACEMENT_RATIO: Param = Param {
     default: Value::Real(0.01),
     get: |p| Value::Real(p.max_displacement_ratio),
     valid: Interval::new(Bound::Closed(1e-7), Bound::Closed(0.1)),
-    valid_why: "Shi advises 0.001–0.01. Above 0.1 contacts are searched 2·δ·w0 away, a tenth of the \
-          model's extent, and a step's rotation is far beyond the small-rotation step; below \
-          10⁻⁷ a whole step moves less than the open–close hysteresis f0 = 2·10⁻⁷ w0 (a generated \
-          wall of 99 998 blocks uses 5·10⁻⁷).",
+    valid_why: "Shi advises 0.001–0.01. Above 0.1 a step may move a vertex a tenth of w0 and \
+          contacts are searched 2·δ·w0 away, a tenth of the model's extent; below 10⁻⁷ a whole \
+          step moves less than the open–close hysteresis f0 = 2·10⁻⁷ w0 (a generated wall of 99 \
+          998 blocks uses 5·10⁻⁷).",
     widget: absolute(1e-4, 0.1, true),
 };
 
@@ -189,7 +190,7 @@ pub const EQUILIBRIUM_MAX_STEPS: Param = Param {
     default: Value::Count(2000),
     get: |p| Value::Count(p.equilibrium_max_steps),
     valid: Interval::new(Bound::Closed(1.0), Bound::Closed(1e6)),
-    valid_why: "a static step brings a block most of the way to rest; a stage that has not settled in \
-          10⁶ steps has a mechanism, not a slow start.",
+    valid_why: "10⁶ static steps cost as much as a run of 10⁴ s at the paper's Δt; a stage that \
+          has not settled by then has a mechanism (a block that slides), not a slow start.",
     widget: None,
 };
