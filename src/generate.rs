@@ -116,4 +116,26 @@ mod tests {
             );
         }
     }
+
+    /// The largest walls --blocks allows, in any layout, are scenes within the input limits: the
+    /// file size, the block count, and the table's ranges (δ shrinks as the wall grows). The
+    /// solver section alone is checked; building 10⁵ blocks is the scene's business.
+    #[test]
+    fn the_largest_walls_stay_within_the_input_limits() {
+        #[derive(serde::Deserialize)]
+        struct Head {
+            solver: crate::params::SolverParams,
+        }
+        for layers in [1, 5, MAX_WALL_BLOCKS] {
+            let text = column_wall(MAX_WALL_BLOCKS, layers, true);
+            assert!(
+                text.len() as u64 <= crate::scene::MAX_FILE_BYTES,
+                "{layers}"
+            );
+            assert_eq!(text.matches("[[blocks]]").count(), crate::scene::MAX_BLOCKS);
+            // The name, [solver], [solver.contact] and [joint] come before the materials.
+            let head: Head = toml::from_str(&text[..text.find("[materials").unwrap()]).unwrap();
+            head.solver.validate().unwrap();
+        }
+    }
 }

@@ -330,4 +330,76 @@ vertices = [[-1,-1,2],[1,-1,2],[1,1,2],[-1,1,2],[-1,-1,4],[1,-1,4],[1,1,4],[-1,1
         );
         assert!(!e.to_string().contains('\n'));
     }
+
+    /// Errors found after parsing carry the line of their key too: the table's checks, the
+    /// materials' constants, and the step limit at the line of whichever key the file sets.
+    #[test]
+    fn checks_after_parsing_point_at_their_key() {
+        let with = |extra: &str| parse_err(&format!("{GOOD}{extra}"));
+        // GOOD ends at line 17; the table added starts at 18.
+        for (extra, line, key) in [
+            (
+                "[joint]\nfriction_angle = 95.0\n",
+                19,
+                "joint.friction_angle",
+            ),
+            ("[joint]\n\ncohesion = -1.0\n", 20, "joint.cohesion"),
+            ("[solver.contact]\nbeta = 1.0\n", 19, "solver.contact.beta"),
+            ("[solver.contact]\neps1 = nan\n", 19, "solver.contact.eps1"),
+        ] {
+            let e = with(extra);
+            assert_eq!(e.line, Some(line), "{e}");
+            assert!(e.message.starts_with(key), "{e}");
+        }
+        // [solver] of GOOD is at line 3, its duration at 4.
+        let e = parse_err(&GOOD.replace("duration = 0.5", "duration = 0.5\nmax_time_step = 1e-8"));
+        assert_eq!(e.line, Some(5), "{e}");
+        let e = parse_err(&GOOD.replace("duration = 0.5", "duration = 1e6"));
+        assert_eq!(e.line, Some(4), "{e}");
+        assert!(e.message.contains("1e8 steps"), "{e}");
+        let e = parse_err(&GOOD.replace("duration = 0.5", "max_time_step = 1e-7"));
+        assert_eq!(e.line, Some(4), "the default duration: Δt_max's line: {e}");
+        let e = parse_err(&GOOD.replace("poisson_ratio = 0.25", "poisson_ratio = 0.5"));
+        assert_eq!(e.line, Some(8), "{e}");
+        let e = parse_err(&GOOD.replace("density = 2750.0", "density = -1e308"));
+        assert_eq!(
+            (e.line, e.message.ends_with("got -1e308")),
+            (Some(6), true),
+            "{e}"
+        );
+    }
+
+    /// A message is one line whatever a name holds.
+    #[test]
+    fn names_with_control_characters_stay_on_one_line() {
+        let e = parse_err(&GOOD.replace("name = \"top\"", "name = \"a\\nb\"\nfixed = 3"));
+        assert!(!e.to_string().contains('\n'), "{e}");
+        let e = parse_err(
+            &GOOD
+                .replace("\"base\"", "\"x\\ny\"")
+                .replace("\"top\"", "\"x\\ny\""),
+        );
+        assert_eq!(e.to_string().lines().count(), 1, "{e}");
+        assert!(e.to_string().contains("'x\\ny' is used twice"), "{e}");
+    }
+
+    /// The README's input limits state the numbers of this module.
+    #[test]
+    fn the_readme_states_the_scene_limits() {
+        let readme = include_str!("../../README.md");
+        let limits = readme.split("### Input limits").nth(1).unwrap();
+        let spaced = |n: usize| {
+            let s = n.to_string();
+            let (head, tail) = s.split_at(s.len() - 3);
+            format!("{head} {tail}")
+        };
+        for needle in [
+            format!("| scene file | {} MiB", MAX_FILE_BYTES >> 20),
+            format!("| blocks | {} per scene", spaced(MAX_BLOCKS)),
+            format!("| points per block | {}", spaced(MAX_BLOCK_POINTS)),
+            format!("1 ≤ N ≤ {}", spaced(crate::generate::MAX_WALL_BLOCKS)),
+        ] {
+            assert!(limits.contains(&needle), "README lacks {needle}");
+        }
+    }
 }
