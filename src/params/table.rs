@@ -1,18 +1,21 @@
-//! One entry per scene-file key of [`SolverParams`]: its label, unit, valid range, the range of
-//! the viewer's widget, default and description.
+//! One entry per scene-file key of [`SolverParams`]: its label, unit, valid range and why it ends
+//! where it does, the range of the viewer's widget, default and description. The entries live in
+//! [`solver_keys`] (`[solver]`) and [`contact_keys`] (`[solver.contact]`, `[joint]`); [`ALL`]
+//! lists them in the scene file's order.
 //!
-//! [`SolverParams::validate`] checks the ranges, the viewer's panel takes its slider ranges,
-//! labels and tooltips from here, and [`markdown_rows`] writes the README's scene table rows. The
-//! tests of [`crate::params`] check the table against the structs: a key for every field, the
-//! same defaults.
+//! [`SolverParams::validate`] checks the ranges and the number of steps a run takes
+//! ([`MAX_STEPS`]), for the scene file and the command line alike; the viewer's panel takes its
+//! slider ranges, labels and tooltips from here; [`markdown_rows`] writes the README's scene
+//! table rows and [`markdown_limits`] its input limits. The tests of [`crate::params`] check the
+//! table against the structs (a key for every field, the same defaults) and the README.
 
 use std::ops::RangeInclusive;
 
 use super::{SolverParams, step_rules};
 use crate::text::short;
 
-mod contact_keys;
-mod solver_keys;
+pub mod contact_keys;
+pub mod solver_keys;
 
 pub use contact_keys::*;
 pub use solver_keys::*;

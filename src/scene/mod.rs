@@ -17,7 +17,12 @@
 //! ```
 //!
 //! - [`format`]: the TOML tables as serde reads them;
-//! - [`build`]: materials checked, shapes turned into blocks, the start checked for overlaps.
+//! - [`build`]: materials checked, shapes turned into blocks, the start checked for overlaps;
+//! - [`locate`]: the line and key of an error, found in the text.
+//!
+//! Every input is bounded (README, "Input limits"): the file's size ([`MAX_FILE_BYTES`]), the
+//! blocks ([`MAX_BLOCKS`]), the points of a block ([`MAX_BLOCK_POINTS`]), and every parameter by
+//! the range of its entry in [`crate::params::table`].
 
 mod build;
 mod format;
