@@ -35,13 +35,13 @@ pub const MAX_REPEAT: usize = 100;
 
 /// `dda3d bench`.
 pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
+    check_options(args).map_err(CliError::Input)?;
     if !args.scene.exists() {
         return Err(CliError::Input(format!(
             "{}: no such scene file",
             args.scene.display()
         )));
     }
-    check_options(args).map_err(CliError::Input)?;
     crate::bench::run(
         &args.scene,
         &args.sizes,
