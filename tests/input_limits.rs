@@ -331,9 +331,15 @@ fn files_are_read_within_bounds() {
         .unwrap();
     let err = one_line_error(&run(&big), "big");
     assert!(
-        err.contains("big.toml: the file is 16 MiB, more than the limit of 16 MiB"),
+        err.contains("big.toml: the file is 16777217 bytes, more than the limit of 16 MiB"),
         "{err}"
     );
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(1 << 34)
+        .unwrap();
+    let err = one_line_error(&run(&big), "16 GiB");
+    assert!(err.contains("the file is 16380 MiB"), "{err}");
     if Path::new("/dev/zero").exists() {
         let err = one_line_error(&run(Path::new("/dev/zero")), "/dev/zero");
         assert!(

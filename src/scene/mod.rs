@@ -42,8 +42,8 @@ use crate::text::short;
 
 /// The largest scene file read, in bytes (16 MiB). The largest generated wall (99 998 blocks)
 /// takes 12.8 MB. toml's parse keeps every number with its place in the text, so the memory of a
-/// parse grows with the text: 55 times a file of boxes, and 88 times (1.4 GB, some 15 s) a file
-/// of nothing but `[0,0,0],`. `run /dev/zero` read until memory ran out.
+/// parse grows with the text: 55 times a file of boxes, and 88 times (1.4 GB, 7 s) a file of
+/// nothing but `[0,0,0],`. `run /dev/zero` read until memory ran out.
 pub const MAX_FILE_BYTES: u64 = 16 << 20;
 
 /// The most blocks a scene may have. The solver's cost grows about linearly with the blocks
@@ -147,10 +147,17 @@ fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
         && meta.is_file()
         && meta.len() > MAX_FILE_BYTES
     {
-        return Err(too_large(&format!(
-            "the file is {} MiB",
-            short(meta.len() as f64 / f64::from(1 << 20))
-        )));
+        // In MiB, short, unless that rounds to the limit itself.
+        let mib = short(meta.len() as f64 / f64::from(1 << 20));
+        let size = if mib
+            .parse()
+            .is_ok_and(|m: f64| m * f64::from(1 << 20) > MAX_FILE_BYTES as f64)
+        {
+            format!("{mib} MiB")
+        } else {
+            format!("{} bytes", meta.len())
+        };
+        return Err(too_large(&format!("the file is {size}")));
     }
     let mut bytes = Vec::new();
     file.take(MAX_FILE_BYTES + 1)
