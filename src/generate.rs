@@ -5,6 +5,14 @@ use std::fmt::Write;
 
 use crate::contact::groups::SIZE_RATIO;
 
+/// The most wall blocks a generated scene may have: with the ground slab and the rock, a scene
+/// of at most [`crate::scene::MAX_BLOCKS`] blocks, so that every generated scene loads.
+pub const MAX_WALL_BLOCKS: usize = crate::scene::MAX_BLOCKS - 2;
+
+/// Δt_max of the generated scenes, s (the paper's): what a scaling run's duration is checked
+/// against (the steps it may take).
+pub const MAX_TIME_STEP: f64 = 0.01;
+
 /// A wall of `blocks` jointed blocks (1.2 m × 1.2 m × 2.0 m, as in the rockfall scene), stacked
 /// `layers` high in columns standing side by side along y, the bottom layer fixed, struck at
 /// mid-length by a dodecahedral rock thrown at 10 m/s. `blocks = 5, layers = 5` is the paper's
@@ -40,7 +48,7 @@ pub fn column_wall(blocks: usize, layers: usize, rock: bool) -> String {
     );
     let _ = writeln!(
         s,
-        "[solver]\nmethod = \"alm\"\nmode = \"dynamic\"\nduration = 2.0\nmax_time_step = 0.01\n\
+        "[solver]\nmethod = \"alm\"\nmode = \"dynamic\"\nduration = 2.0\nmax_time_step = {MAX_TIME_STEP}\n\
          max_displacement_ratio = {delta:.6e}\ngravity = [0.0, 0.0, -9.8]\n"
     );
     let _ = writeln!(
@@ -108,6 +116,28 @@ mod tests {
                 scene.model.blocks.iter().filter(|b| b.fixed).count(),
                 n.div_ceil(layers) + 1
             );
+        }
+    }
+
+    /// The largest walls --blocks allows, in any layout, are scenes within the input limits: the
+    /// file size, the block count, and the table's ranges (δ shrinks as the wall grows). The
+    /// solver section alone is checked; building 10⁵ blocks is the scene's business.
+    #[test]
+    fn the_largest_walls_stay_within_the_input_limits() {
+        #[derive(serde::Deserialize)]
+        struct Head {
+            solver: crate::params::SolverParams,
+        }
+        for layers in [1, 5, MAX_WALL_BLOCKS] {
+            let text = column_wall(MAX_WALL_BLOCKS, layers, true);
+            assert!(
+                text.len() as u64 <= crate::scene::MAX_FILE_BYTES,
+                "{layers}"
+            );
+            assert_eq!(text.matches("[[blocks]]").count(), crate::scene::MAX_BLOCKS);
+            // The name, [solver], [solver.contact] and [joint] come before the materials.
+            let head: Head = toml::from_str(&text[..text.find("[materials").unwrap()]).unwrap();
+            head.solver.validate().unwrap();
         }
     }
 }

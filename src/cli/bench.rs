@@ -6,38 +6,41 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::CliError;
+use crate::generate::MAX_WALL_BLOCKS;
+use crate::params::SolverParams;
 
 #[derive(Args, Debug)]
 pub struct BenchArgs {
     /// The rockfall scene to time.
     #[arg(long, default_value = "scenes/rock_column_rockfall.toml")]
     pub scene: PathBuf,
-    /// Generated wall sizes for the scaling study with the rockfall (comma separated).
-    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "10,100")]
+    /// Generated wall sizes for the scaling study with the rockfall (comma separated, each
+    /// 1..=99998).
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "10,100", allow_negative_numbers = true)]
     pub sizes: Vec<usize>,
     /// Generated wall sizes for the scaling study of a standing wall (no rock).
-    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "10,100,1000")]
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "10,100,1000", allow_negative_numbers = true)]
     pub standing_sizes: Vec<usize>,
-    /// Runs per measurement; the fastest is reported.
-    #[arg(long, default_value_t = 3)]
+    /// Runs per measurement (1..=100); the fastest is reported.
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true)]
     pub repeat: usize,
     /// Simulated time of the scaling runs, s.
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub scaling_duration: f64,
 }
 
+/// The most runs per measurement: the best of 100 is as good as a minimum gets, and a bound
+/// keeps a typo (`--repeat 30000`) from running for days.
+pub const MAX_REPEAT: usize = 100;
+
 /// `dda3d bench`.
 pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
+    check_options(args).map_err(CliError::Input)?;
     if !args.scene.exists() {
         return Err(CliError::Input(format!(
             "{}: no such scene file",
             args.scene.display()
         )));
-    }
-    if !(args.scaling_duration.is_finite() && args.scaling_duration > 0.0) {
-        return Err(CliError::Input(
-            "--scaling-duration must be positive".into(),
-        ));
     }
     crate::bench::run(
         &args.scene,
@@ -47,4 +50,39 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
         args.scaling_duration,
     )
     .map_err(CliError::Run)
+}
+
+/// The wall sizes, the repeat count and the scaling runs' duration, checked before anything is
+/// generated or run: a wall of 10⁹ blocks ran out of memory after 12.9 GB, and a wall of 0
+/// printed `inf`.
+fn check_options(args: &BenchArgs) -> Result<(), String> {
+    for (flag, sizes) in [
+        ("--sizes", &args.sizes),
+        ("--standing-sizes", &args.standing_sizes),
+    ] {
+        if let Some(n) = sizes.iter().find(|n| !(1..=MAX_WALL_BLOCKS).contains(n)) {
+            return Err(format!(
+                "{flag}: each wall size must lie in 1..={MAX_WALL_BLOCKS} blocks, got {n}"
+            ));
+        }
+    }
+    if !(1..=MAX_REPEAT).contains(&args.repeat) {
+        return Err(format!(
+            "--repeat must lie in 1..={MAX_REPEAT}, got {}",
+            args.repeat
+        ));
+    }
+    let d = args.scaling_duration;
+    if !(d.is_finite() && d > 0.0) {
+        return Err("--scaling-duration must be positive".into());
+    }
+    // The generated walls' parameters, with this duration: the table's range and step limit.
+    let params = SolverParams {
+        duration: d,
+        max_time_step: crate::generate::MAX_TIME_STEP,
+        ..SolverParams::default()
+    };
+    params
+        .validate()
+        .map_err(|e| format!("--scaling-duration: {e}"))
 }

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::CliError;
+use crate::generate::MAX_WALL_BLOCKS;
 
 /// Kinds of generated scenes.
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -18,11 +19,11 @@ pub struct GenerateArgs {
     /// What to generate.
     #[arg(value_enum)]
     pub kind: GeneratedKind,
-    /// Number of jointed blocks (not counting the ground slab and the rock).
-    #[arg(long, default_value_t = 5)]
+    /// Number of jointed blocks (not counting the ground slab and the rock), at most 99998.
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
     pub blocks: usize,
-    /// Blocks per column.
-    #[arg(long, default_value_t = 5)]
+    /// Blocks per column (at most --blocks: one column).
+    #[arg(long, default_value_t = 5, allow_negative_numbers = true)]
     pub layers: usize,
     /// Leave out the rock: a standing wall (to measure the cost of the machinery alone).
     #[arg(long)]
@@ -34,9 +35,10 @@ pub struct GenerateArgs {
 
 /// `dda3d generate`.
 pub fn generate(args: &GenerateArgs) -> Result<(), CliError> {
-    if args.blocks == 0 || args.blocks > 1_000_000 {
+    // Within the scene's block limit, so that what is written loads.
+    if !(1..=MAX_WALL_BLOCKS).contains(&args.blocks) {
         return Err(CliError::Input(format!(
-            "--blocks must lie in 1..=1000000, got {}",
+            "--blocks must lie in 1..={MAX_WALL_BLOCKS}, got {}",
             args.blocks
         )));
     }

@@ -18,10 +18,12 @@ use std::ffi::OsString;
 use std::path::Path;
 use std::process::ExitCode;
 
+use clap::error::ErrorKind;
 use clap::{Args, Parser};
 
-use crate::params::{Method, Mode};
+use crate::params::{Method, Mode, table};
 use crate::scene::{self, Scene, SceneError};
+use crate::text::short;
 
 pub use bench::{BenchArgs, bench};
 pub use generate::{GenerateArgs, GeneratedKind, generate};
@@ -54,7 +56,9 @@ pub enum CliCommand {
     View(ViewArgs),
 }
 
-/// Overrides of the scene's `[solver]` table, shared by the commands that simulate.
+/// Overrides of the scene's `[solver]` table, shared by the commands that simulate. The numbers
+/// take a leading minus as a value (`--duration -1`), which [`load_scene`] then rejects with
+/// the range of the parameter table, as in a scene file.
 #[derive(Args, Debug, Clone, Default)]
 pub struct SolverOverrides {
     /// Contact method: alm (DDA-3a) or penalty (DDA-3p).
@@ -64,11 +68,14 @@ pub struct SolverOverrides {
     #[arg(long, value_enum)]
     pub mode: Option<Mode>,
     /// Numerical dissipation ρ∞ of the dynamic step, in [1/3, 1] (1: Shi's step).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub spectral_radius: Option<f64>,
     /// Simulated time, s.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
+    /// Largest time step Δt_max, s (the scene's `max_time_step`).
+    #[arg(long, allow_negative_numbers = true)]
+    pub max_time_step: Option<f64>,
     /// Bring the model to rest under gravity before the run starts (the scene's
     /// `initial_equilibrium = true`).
     #[arg(long)]
@@ -104,7 +111,8 @@ impl From<SceneError> for CliError {
     }
 }
 
-/// Loads a scene and applies the command-line overrides.
+/// Loads a scene and applies the command-line overrides, which the parameter table checks as it
+/// checks the scene file: a failure names the flag that set the value.
 pub fn load_scene(path: &Path, o: &SolverOverrides) -> Result<Scene, CliError> {
     let mut s = scene::load(path)?;
     if let Some(m) = o.method {
@@ -113,23 +121,49 @@ pub fn load_scene(path: &Path, o: &SolverOverrides) -> Result<Scene, CliError> {
     if let Some(m) = o.mode {
         s.params.mode = m;
     }
-    if let Some(r) = o.spectral_radius {
-        s.params.spectral_radius = r;
-        s.params
-            .validate()
-            .map_err(|e| CliError::Input(format!("--spectral-radius: {e}")))?;
-    }
     if o.initial_equilibrium {
         s.params.initial_equilibrium = true;
     }
-    if let Some(d) = o.duration {
-        if !(d.is_finite() && d > 0.0) {
-            return Err(CliError::Input(format!(
-                "--duration must be a positive number of seconds, got {d}"
-            )));
-        }
-        s.params.duration = d;
+    if let Some(d) = o.duration
+        && !(d.is_finite() && d > 0.0)
+    {
+        return Err(CliError::Input(format!(
+            "--duration must be a positive number of seconds, got {}",
+            short(d)
+        )));
     }
+    // (flag, key) of every number set from the command line.
+    let mut set = Vec::new();
+    let p = &mut s.params;
+    for (flag, param, value, field) in [
+        (
+            "--spectral-radius",
+            &table::SPECTRAL_RADIUS,
+            o.spectral_radius,
+            &mut p.spectral_radius,
+        ),
+        ("--duration", &table::DURATION, o.duration, &mut p.duration),
+        (
+            "--max-time-step",
+            &table::MAX_TIME_STEP,
+            o.max_time_step,
+            &mut p.max_time_step,
+        ),
+    ] {
+        if let Some(v) = value {
+            *field = v;
+            set.push((flag, param.key));
+        }
+    }
+    s.params.check().map_err(|e| {
+        // The scene file alone was valid, so a flag set one of the keys the failure concerns.
+        let flag = e
+            .keys
+            .iter()
+            .find_map(|k| set.iter().find(|(_, key)| key == k))
+            .map_or_else(|| path.display().to_string(), |(f, _)| f.to_string());
+        CliError::Input(format!("{flag}: {}", e.message))
+    })?;
     Ok(s)
 }
 
@@ -149,7 +183,7 @@ pub fn dispatch(cli: &Cli) -> Result<(), CliError> {
 /// `main`, before any other thread starts (it may set an environment variable).
 pub fn main_entry() -> ExitCode {
     quiet_mesa_runtime_dir();
-    let cli = Cli::parse_from(expand_scene_shorthand(std::env::args_os().collect()));
+    let cli = parse_command_line();
     // `run` and `render` say which kind of failure ended them. Of the others, `generate` can
     // only fail to write its file, the viewer's window or GPU can fail (a solver error stays in
     // the window), and `bench` fails when one of its runs does.
@@ -171,6 +205,44 @@ pub fn main_entry() -> ExitCode {
             ExitCode::from(f.status().code())
         }
     }
+}
+
+/// The process's command line, parsed. A usage error is one line on stderr (clap's message,
+/// its tip in brackets, without the usage block) and exit status 2; `--help` and `--version`
+/// print as clap prints them.
+fn parse_command_line() -> Cli {
+    match Cli::try_parse_from(expand_scene_shorthand(std::env::args_os().collect())) {
+        Ok(cli) => cli,
+        Err(e)
+            if e.use_stderr()
+                && e.kind() != ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
+        {
+            eprintln!("{}", one_line_usage_error(&e.render().to_string()));
+            std::process::exit(e.exit_code());
+        }
+        Err(e) => e.exit(),
+    }
+}
+
+/// clap's rendered error as one line: the lines before `Usage:`, joined, with a `tip:` in
+/// brackets.
+fn one_line_usage_error(rendered: &str) -> String {
+    let mut line = String::new();
+    for part in rendered
+        .lines()
+        .map(str::trim)
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .filter(|l| !l.is_empty())
+    {
+        if line.is_empty() {
+            line = part.to_string();
+        } else if part.starts_with("tip:") {
+            line += &format!(" ({part})");
+        } else {
+            line += &format!(" {part}");
+        }
+    }
+    line
 }
 
 /// Mesa's drivers warn on every start when XDG_RUNTIME_DIR is unset (common over SSH and in CI);

@@ -8,6 +8,7 @@
 
 use serde::{Deserialize, Serialize};
 
+pub mod numbers;
 pub mod table;
 
 /// Shi's step-control rules (reference §6.3, §8). They are part of the method, not tunables; the
@@ -188,6 +189,7 @@ pub struct SolverParams {
     /// largest extent of the model's bounding box).
     pub max_displacement_ratio: f64,
     /// Gravity, m/s²; z is up.
+    #[serde(deserialize_with = "numbers::exact")]
     pub gravity: [f64; 3],
     /// Stiffness of the vertex springs of fixed blocks, as a multiple of the block's E
     /// (the paper uses 100 E).
@@ -235,18 +237,41 @@ impl Default for SolverParams {
     }
 }
 
+/// A value [`SolverParams::check`] rejects: the message, and the scene-file keys it concerns,
+/// the one to point at first (the message's line, the flag that set it) first.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Invalid {
+    pub keys: &'static [&'static str],
+    pub message: String,
+}
+
 impl SolverParams {
-    /// Checks every value against the range of its [`table`] entry; returns a message naming the
-    /// offending key. Every number is first checked to be finite, then each against its range,
-    /// both in the table's (the scene file's) order.
+    /// Checks every value against the range of its [`table`] entry, then the number of steps the
+    /// run would take ([`table::MAX_STEPS`]); returns a message naming the offending key. Every
+    /// number is first checked to be finite, then each against its range, both in the table's
+    /// (the scene file's) order.
     pub fn validate(&self) -> Result<(), String> {
+        self.check().map_err(|e| e.message)
+    }
+
+    /// [`SolverParams::validate`], with the keys the failure concerns.
+    pub fn check(&self) -> Result<(), Invalid> {
+        let invalid = |p: &'static table::Param| {
+            move |message| Invalid {
+                keys: std::slice::from_ref(&p.key),
+                message,
+            }
+        };
         for p in table::ALL {
-            p.check_finite(self)?;
+            p.check_finite(self).map_err(invalid(p))?;
         }
         for p in table::ALL {
-            p.check_range(self)?;
+            p.check_range(self).map_err(invalid(p))?;
         }
-        Ok(())
+        table::check_steps(self).map_err(|message| Invalid {
+            keys: &[table::DURATION.key, table::MAX_TIME_STEP.key],
+            message,
+        })
     }
 }
 
@@ -403,6 +428,132 @@ mod tests {
             "{passes}"
         );
         assert!(MAX_TIME_STEP.doc().contains("≤ 1.3×"));
+    }
+
+    /// The README's input limits list every bounded key with the table's range and reason.
+    #[test]
+    fn the_readme_lists_the_bounds_of_the_table() {
+        let readme = include_str!("../../README.md");
+        let limits = readme
+            .split("### Input limits")
+            .nth(1)
+            .expect("README has ### Input limits");
+        for row in markdown_limits().lines() {
+            assert!(limits.contains(row), "README lacks the row\n{row}");
+        }
+        assert!(limits.contains("10⁷ steps"), "the step limit");
+        assert_eq!(MAX_STEPS, 1e7);
+    }
+
+    /// Every bounded key says why, the bounds print short, and the shipped defaults lie inside.
+    #[test]
+    fn bounds_have_reasons_and_read_short() {
+        for p in [
+            &DURATION,
+            &MAX_TIME_STEP,
+            &MAX_DISPLACEMENT_RATIO,
+            &EPS1,
+            &EPS2,
+            &MAX_ALM_ITERATIONS,
+            &MAX_OPEN_CLOSE_ITERATIONS,
+            &CLOSE_THRESHOLD,
+            &OPEN_THRESHOLD,
+        ] {
+            assert!(!p.valid_why.is_empty(), "{}", p.key);
+            assert!(p.doc().contains("Valid: "), "{}", p.key);
+            assert!(p.valid.lo != Bound::Unbounded && p.valid.hi != Bound::Unbounded);
+        }
+        assert_eq!(MAX_TIME_STEP.valid_range(), "[1e-7, 1] s");
+        assert_eq!(DURATION.valid_range(), "[1e-7, 1e7] s");
+        assert_eq!(MAX_DISPLACEMENT_RATIO.valid_range(), "[1e-7, 0.1]");
+        assert_eq!(SPECTRAL_RADIUS.valid_range(), "[1/3, 1]");
+        // The longest run the ranges allow is the step limit at the longest step.
+        let longest = |b: Bound| match b {
+            Bound::Closed(x) | Bound::Open(x) => x,
+            Bound::Unbounded => f64::INFINITY,
+        };
+        assert_eq!(
+            longest(DURATION.valid.hi) / longest(MAX_TIME_STEP.valid.hi),
+            MAX_STEPS
+        );
+        // The shortest run takes a step at the longest Δt_max (the solver ends a run within
+        // 1e-9·Δt_max of its end).
+        let (Bound::Closed(shortest), Bound::Closed(dt_max)) =
+            (DURATION.valid.lo, MAX_TIME_STEP.valid.hi)
+        else {
+            panic!("closed bounds")
+        };
+        assert!(shortest > 1e-9 * dt_max);
+    }
+
+    /// Families of absurd time controls, each rejected naming its key with the number short;
+    /// the step limit names both keys.
+    #[test]
+    fn absurd_time_controls_are_rejected() {
+        let with = |f: &dyn Fn(&mut SolverParams)| {
+            let mut p = SolverParams::default();
+            f(&mut p);
+            p.check()
+        };
+        for dt in [0.0, -1.0, 1e-15, 9.9e-8, 1.01, 2.0, 1e9, 3e9, 1e308] {
+            let e = with(&|p| p.max_time_step = dt).unwrap_err();
+            assert_eq!(e.keys, [MAX_TIME_STEP.key]);
+            assert!(e.message.contains("[1e-7, 1] s"), "{}", e.message);
+            assert!(e.message.len() < 100, "short: {}", e.message);
+        }
+        for d in [0.0, -1.0, 1e-300, 1e-12, 9e-8, 1.1e7, 1e308] {
+            let e = with(&|p| p.duration = d).unwrap_err();
+            assert_eq!(e.keys, [DURATION.key], "{d}");
+            assert!(e.message.len() < 100, "short: {}", e.message);
+        }
+        for r in [0.0, 1e-9, 0.11, 1.0, 1e300] {
+            let e = with(&|p| p.max_displacement_ratio = r).unwrap_err();
+            assert_eq!(e.keys, [MAX_DISPLACEMENT_RATIO.key]);
+        }
+        for (d, dt) in [(1e6, 0.01), (2.0, 1e-7), (1e7, 0.5), (100.0, 9e-6)] {
+            let e = with(&|p| {
+                p.duration = d;
+                p.max_time_step = dt;
+            })
+            .unwrap_err();
+            assert_eq!(e.keys, [DURATION.key, MAX_TIME_STEP.key]);
+            assert!(
+                e.message.contains("more than the limit of 1e7"),
+                "{}",
+                e.message
+            );
+        }
+        // At the limit and inside it.
+        for (d, dt) in [
+            (1e5, 0.01),
+            (1e7, 1.0),
+            (1.0, 1e-7),
+            (1e-7, 1.0),
+            (2.0, 1e-6),
+        ] {
+            with(&|p| {
+                p.duration = d;
+                p.max_time_step = dt;
+            })
+            .unwrap_or_else(|e| panic!("{d} s at {dt} s: {}", e.message));
+        }
+        for n in [0, 1001, u32::MAX] {
+            assert!(with(&|p| p.contact.max_alm_iterations = n).is_err());
+            assert!(with(&|p| p.contact.max_open_close_iterations = n).is_err());
+        }
+        for eps in [1.0, 10.0, 1e300] {
+            assert!(with(&|p| p.contact.eps1 = eps).is_err());
+            assert!(with(&|p| p.contact.eps2 = eps).is_err());
+        }
+        for f in [0.011, 1.0, 1e300] {
+            assert!(with(&|p| p.contact.close_threshold = f).is_err());
+            assert!(with(&|p| p.contact.open_threshold = f).is_err());
+        }
+        let e = with(&|p| p.contact.beta = 1.000_000_001).unwrap_err();
+        assert_eq!(
+            e.message, "solver.contact.beta must lie in (0, 1), got 1.000000001",
+            "a value rounded into the range prints in full"
+        );
     }
 
     /// Keys the README's scene table does not have yet.

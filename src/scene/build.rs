@@ -2,6 +2,7 @@
 //! a convex hull, and the blocks checked for overlap at the start. Messages here are the problem
 //! alone; [`super::parse`] adds the file, the line and the block's name.
 
+use super::MAX_BLOCK_POINTS;
 use super::format::BlockSpec;
 use crate::contact::Shape;
 use crate::contact::detection::broad_phase;
@@ -11,34 +12,59 @@ use crate::physics::geometry::{
     prism_vertices, rotation_xyz_degrees,
 };
 use crate::physics::mechanics::Material;
+use crate::text::short;
 
-/// Checks a material's constants.
-pub(super) fn check_material(name: &str, m: &Material) -> Result<(), String> {
+/// Checks a material's constants; an error names the key it concerns.
+pub(super) fn check_material(name: &str, m: &Material) -> Result<(), (&'static str, String)> {
     for (key, v) in [
         ("density", m.density),
         ("young_modulus", m.young_modulus),
         ("poisson_ratio", m.poisson_ratio),
     ] {
         if !v.is_finite() {
-            return Err(format!("material '{name}': {key} is not a finite number"));
+            return Err((
+                key,
+                format!("material '{name}': {key} is not a finite number"),
+            ));
         }
     }
     if m.density <= 0.0 {
-        return Err(format!(
-            "material '{name}': density must be positive, got {}",
-            m.density
+        return Err((
+            "density",
+            format!(
+                "material '{name}': density must be positive, got {}",
+                short(m.density)
+            ),
         ));
     }
     if m.young_modulus <= 0.0 {
-        return Err(format!(
-            "material '{name}': young_modulus must be positive, got {}",
-            m.young_modulus
+        return Err((
+            "young_modulus",
+            format!(
+                "material '{name}': young_modulus must be positive, got {}",
+                short(m.young_modulus)
+            ),
         ));
     }
     if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
+        return Err((
+            "poisson_ratio",
+            format!(
+                "material '{name}': poisson_ratio must lie in (-1, 0.5), got {}",
+                short(m.poisson_ratio)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// An error when a shape has more points than [`MAX_BLOCK_POINTS`] (`what` says which points):
+/// checked before the hull, whose cost grows with them.
+fn check_point_count(points: usize, what: impl FnOnce() -> String) -> Result<(), String> {
+    if points > MAX_BLOCK_POINTS {
         return Err(format!(
-            "material '{name}': poisson_ratio must lie in (-1, 0.5), got {}",
-            m.poisson_ratio
+            "{}, more than the limit of {MAX_BLOCK_POINTS} points for a block",
+            what()
         ));
     }
     Ok(())
@@ -64,7 +90,8 @@ fn shape_points(spec: &BlockSpec) -> Result<Vec<Vec3>, String> {
         return Err("give exactly one of vertices, box, dodecahedron or prism".into());
     }
     if let Some(v) = &spec.vertices {
-        return Ok(v.iter().map(|p| Vec3::from(*p)).collect());
+        check_point_count(v.len(), || format!("vertices: {} points", v.len()))?;
+        return Ok(v.iter().map(|p| Vec3::from(p.0)).collect());
     }
     if let Some(b) = &spec.box_ {
         if !finite(&b.size) || !finite(&b.center) || !finite(&b.rotation) {
@@ -93,10 +120,19 @@ fn shape_points(spec: &BlockSpec) -> Result<Vec<Vec3>, String> {
         ));
     }
     let p = spec.prism.as_ref().expect("one shape given");
-    if !finite(&p.extrude) || p.base.iter().any(|b| !finite(b)) {
+    // The prism's vertices are its base and the base swept.
+    check_point_count(2 * p.base.len(), || {
+        format!(
+            "prism: a base of {} points makes {} vertices",
+            p.base.len(),
+            2 * p.base.len()
+        )
+    })?;
+    let base: Vec<[f64; 3]> = p.base.iter().map(|b| b.0).collect();
+    if !finite(&p.extrude) || base.iter().any(|b| !finite(b)) {
         return Err("prism has a non-finite number".into());
     }
-    Ok(prism_vertices(&p.base, p.extrude))
+    Ok(prism_vertices(&base, p.extrude))
 }
 
 /// One block from its `[[blocks]]` entry.
@@ -162,8 +198,10 @@ pub(super) fn check_overlaps(blocks: &[Block]) -> Result<(), (usize, String)> {
             return Err((
                 b,
                 format!(
-                    "blocks '{}' and '{}' overlap by {:.3e} m at the start (touching is fine)",
-                    blocks[a].name, blocks[b].name, depth
+                    "blocks '{}' and '{}' overlap by {} m at the start (touching is fine)",
+                    blocks[a].name,
+                    blocks[b].name,
+                    short(depth)
                 ),
             ));
         }

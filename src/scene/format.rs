@@ -1,12 +1,14 @@
 //! The scene file's TOML format, as serde reads it. Every table denies unknown keys, so a typo is
-//! an error with its line, not a silently ignored setting. The shapes of `[[blocks]]` are built
-//! into blocks by [`super::build`].
+//! an error with its line, not a silently ignored setting, and every list of numbers takes
+//! exactly its length ([`exact`]: `[0, -1, 0, 99]` is not a point). The shapes of `[[blocks]]`
+//! are built into blocks by [`super::build`].
 
 use std::collections::BTreeMap;
 
 use serde::Deserialize;
 use toml::Spanned;
 
+use crate::params::numbers::{Exact, exact};
 use crate::params::{JointParams, SolverParams};
 use crate::physics::mechanics::Material;
 
@@ -33,12 +35,12 @@ pub(super) struct BlockSpec {
     #[serde(default)]
     pub(super) fixed: bool,
     /// Initial centroid velocity, m/s.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact")]
     pub(super) velocity: [f64; 3],
     /// Initial angular velocity, rad/s.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact")]
     pub(super) angular_velocity: [f64; 3],
-    pub(super) vertices: Option<Vec<[f64; 3]>>,
+    pub(super) vertices: Option<Vec<Exact<3>>>,
     #[serde(rename = "box")]
     pub(super) box_: Option<BoxSpec>,
     pub(super) dodecahedron: Option<DodecahedronSpec>,
@@ -52,10 +54,12 @@ pub(super) struct BlockSpec {
 #[serde(deny_unknown_fields)]
 pub(super) struct BoxSpec {
     /// Edge lengths along the block's own x, y, z, m.
+    #[serde(deserialize_with = "exact")]
     pub(super) size: [f64; 3],
+    #[serde(deserialize_with = "exact")]
     pub(super) center: [f64; 3],
     /// Rotation about x, then y, then z (fixed axes), degrees.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact")]
     pub(super) rotation: [f64; 3],
 }
 
@@ -64,8 +68,9 @@ pub(super) struct BoxSpec {
 pub(super) struct DodecahedronSpec {
     /// Edge length, m.
     pub(super) edge: f64,
+    #[serde(deserialize_with = "exact")]
     pub(super) center: [f64; 3],
-    #[serde(default)]
+    #[serde(default, deserialize_with = "exact")]
     pub(super) rotation: [f64; 3],
 }
 
@@ -73,14 +78,17 @@ pub(super) struct DodecahedronSpec {
 #[serde(deny_unknown_fields)]
 pub(super) struct PrismSpec {
     /// A convex polygon.
-    pub(super) base: Vec<[f64; 3]>,
+    pub(super) base: Vec<Exact<3>>,
     /// The sweep vector from the base to the top face.
+    #[serde(deserialize_with = "exact")]
     pub(super) extrude: [f64; 3],
 }
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct LoadSpec {
+    #[serde(deserialize_with = "exact")]
     pub(super) point: [f64; 3],
+    #[serde(deserialize_with = "exact")]
     pub(super) force: [f64; 3],
 }

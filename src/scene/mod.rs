@@ -17,19 +17,43 @@
 //! ```
 //!
 //! - [`format`]: the TOML tables as serde reads them;
-//! - [`build`]: materials checked, shapes turned into blocks, the start checked for overlaps.
+//! - [`build`]: materials checked, shapes turned into blocks, the start checked for overlaps;
+//! - [`locate`]: the line and key of an error, found in the text.
+//!
+//! Every input is bounded (README, "Input limits"): the file's size ([`MAX_FILE_BYTES`]), the
+//! blocks ([`MAX_BLOCKS`]), the points of a block ([`MAX_BLOCK_POINTS`]), and every parameter by
+//! the range of its entry in [`crate::params::table`].
 
 mod build;
 mod format;
+mod locate;
 
 use std::fmt;
+use std::io::Read;
 use std::path::Path;
 
 use build::{build_block, check_material, check_overlaps};
 use format::SceneFile;
+use locate::{key_at, key_line, line_of};
 
 use crate::model::Model;
 use crate::params::SolverParams;
+use crate::text::short;
+
+/// The largest scene file read, in bytes (16 MiB). The largest generated wall (99 998 blocks)
+/// takes 12.8 MB. toml's parse keeps every number with its place in the text, so the memory of a
+/// parse grows with the text: 55 times a file of boxes, and 88 times (1.4 GB, 7 s) a file of
+/// nothing but `[0,0,0],`. `run /dev/zero` read until memory ran out.
+pub const MAX_FILE_BYTES: u64 = 16 << 20;
+
+/// The most blocks a scene may have. The solver's cost grows about linearly with the blocks
+/// (README, Performance: a wall of 1000 blocks runs in minutes), so 10⁵ is already a long run;
+/// `dda3d generate` writes walls up to this size.
+pub const MAX_BLOCKS: usize = 100_000;
+
+/// The most points a block's shape may have (`vertices`, or twice a prism's base): the convex
+/// hull of 10⁵ points takes well under a second in O(n log n), and a real block has tens.
+pub const MAX_BLOCK_POINTS: usize = 100_000;
 
 /// A bad scene: one line naming the file, the line when known, and the problem.
 #[derive(Debug, Clone, PartialEq)]
@@ -41,11 +65,29 @@ pub struct SceneError {
 
 impl fmt::Display for SceneError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self.line {
-            Some(l) => write!(f, "{}: line {}: {}", self.path, l, self.message),
-            None => write!(f, "{}: {}", self.path, self.message),
-        }
+        let text = match self.line {
+            Some(l) => format!("{}: line {}: {}", self.path, l, self.message),
+            None => format!("{}: {}", self.path, self.message),
+        };
+        // One line, whatever a name or a path in it holds (a block named "a\nb").
+        f.write_str(&one_line(&text))
     }
+}
+
+/// Control characters (a newline in a name, say) written as escapes.
+fn one_line(text: &str) -> String {
+    if !text.chars().any(char::is_control) {
+        return text.to_string();
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
 }
 
 impl std::error::Error for SceneError {}
@@ -61,10 +103,27 @@ pub struct Scene {
 /// Reads and validates a scene file.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
     let shown = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+    let err = |line: Option<usize>, message: String| SceneError {
         path: shown.clone(),
-        line: None,
-        message: format!("cannot read: {e}"),
+        line,
+        message,
+    };
+    let bytes = read_bounded(path).map_err(|m| err(None, m))?;
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let bytes = e.as_bytes();
+        let bad = e.utf8_error().valid_up_to();
+        let line_start = bytes[..bad]
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |k| k + 1);
+        err(
+            Some(bytes[..bad].iter().filter(|&&b| b == b'\n').count() + 1),
+            format!(
+                "not UTF-8 text: byte 0x{:02x} at column {} (a scene file is TOML, which is UTF-8)",
+                bytes[bad],
+                bad - line_start + 1
+            ),
+        )
     })?;
     let default_name = path
         .file_stem()
@@ -73,8 +132,63 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
     parse(&text, &shown, &default_name)
 }
 
-fn line_of(text: &str, offset: usize) -> usize {
-    text[..offset.min(text.len())].matches('\n').count() + 1
+/// The file's bytes, at most [`MAX_FILE_BYTES`] of them. A regular file says its size up front;
+/// a device, pipe or terminal (`/dev/zero`) does not, and is read up to the limit.
+fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
+    let cannot = |e: std::io::Error| format!("cannot read: {e}");
+    let file = std::fs::File::open(path).map_err(cannot)?;
+    let too_large = |size: &str| {
+        format!(
+            "{size}, more than the limit of {} MiB for a scene file",
+            MAX_FILE_BYTES >> 20
+        )
+    };
+    if let Ok(meta) = file.metadata()
+        && meta.is_file()
+        && meta.len() > MAX_FILE_BYTES
+    {
+        // In MiB, short, unless that rounds to the limit itself.
+        let mib = short(meta.len() as f64 / f64::from(1 << 20));
+        let size = if mib
+            .parse()
+            .is_ok_and(|m: f64| m * f64::from(1 << 20) > MAX_FILE_BYTES as f64)
+        {
+            format!("{mib} MiB")
+        } else {
+            format!("{} bytes", meta.len())
+        };
+        return Err(too_large(&format!("the file is {size}")));
+    }
+    let mut bytes = Vec::new();
+    file.take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)
+        .map_err(cannot)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(too_large("the input goes on"));
+    }
+    Ok(bytes)
+}
+
+/// The line and message of a toml error: its line from its offset, and the key of the value it
+/// rejects where the message does not name it (`solver.gravity: expected 3 numbers, got 4`).
+fn toml_error(text: &str, e: &toml::de::Error) -> (Option<usize>, String) {
+    let message = e.message().trim().replace('\n', " ");
+    let Some(span) = e.span() else {
+        return (None, message);
+    };
+    let line = Some(line_of(text, span.start));
+    match key_at(text, span.start) {
+        Some(key) if !message.contains(&format!("`{key}`")) => (line, format!("{key}: {message}")),
+        _ => (line, message),
+    }
+}
+
+/// The line of the first of `keys` (`solver.contact.beta`) that the text sets.
+fn first_key_line(text: &str, keys: &[&str]) -> Option<usize> {
+    keys.iter().find_map(|k| {
+        let path: Vec<&str> = k.split('.').collect();
+        key_line(text, &path)
+    })
 }
 
 /// Parses scene text; `path` is used in messages only.
@@ -85,21 +199,35 @@ pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneE
         message,
     };
     let file: SceneFile = toml::from_str(text).map_err(|e| {
-        let line = e.span().map(|s| line_of(text, s.start));
-        err(line, e.message().trim().replace('\n', " "))
+        let (line, message) = toml_error(text, &e);
+        err(line, message)
     })?;
     let mut params = file.solver;
     params.joint = file.joint;
-    params.validate().map_err(|m| err(None, m))?;
+    params
+        .check()
+        .map_err(|e| err(first_key_line(text, e.keys), e.message))?;
 
     for (name, m) in &file.materials {
-        check_material(name, m.get_ref())
-            .map_err(|e| err(Some(line_of(text, m.span().start)), e))?;
+        check_material(name, m.get_ref()).map_err(|(key, e)| {
+            let line = key_line(text, &["materials", name, key])
+                .unwrap_or_else(|| line_of(text, m.span().start));
+            err(Some(line), e)
+        })?;
     }
     if file.blocks.is_empty() {
         return Err(err(
             None,
             "no [[blocks]]: a scene needs at least one block".into(),
+        ));
+    }
+    if let Some(extra) = file.blocks.get(MAX_BLOCKS) {
+        return Err(err(
+            Some(line_of(text, extra.span().start)),
+            format!(
+                "{} blocks, more than the limit of {MAX_BLOCKS} for a scene",
+                file.blocks.len()
+            ),
         ));
     }
 
@@ -123,8 +251,10 @@ pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneE
         blocks.push(build_block(spec, name.clone(), material).map_err(berr)?);
         lines.push(line);
     }
+    // A set, not a scan of the blocks before each: 10⁵ blocks are 5·10⁹ comparisons.
+    let mut names = std::collections::HashSet::with_capacity(blocks.len());
     for (k, b) in blocks.iter().enumerate() {
-        if blocks[..k].iter().any(|o| o.name == b.name) {
+        if !names.insert(b.name.as_str()) {
             return Err(err(
                 lines[k],
                 format!("block name '{}' is used twice", b.name),
@@ -211,5 +341,77 @@ vertices = [[-1,-1,2],[1,-1,2],[1,1,2],[-1,1,2],[-1,-1,4],[1,-1,4],[1,1,4],[-1,1
             "{e}"
         );
         assert!(!e.to_string().contains('\n'));
+    }
+
+    /// Errors found after parsing carry the line of their key too: the table's checks, the
+    /// materials' constants, and the step limit at the line of whichever key the file sets.
+    #[test]
+    fn checks_after_parsing_point_at_their_key() {
+        let with = |extra: &str| parse_err(&format!("{GOOD}{extra}"));
+        // GOOD ends at line 17; the table added starts at 18.
+        for (extra, line, key) in [
+            (
+                "[joint]\nfriction_angle = 95.0\n",
+                19,
+                "joint.friction_angle",
+            ),
+            ("[joint]\n\ncohesion = -1.0\n", 20, "joint.cohesion"),
+            ("[solver.contact]\nbeta = 1.0\n", 19, "solver.contact.beta"),
+            ("[solver.contact]\neps1 = nan\n", 19, "solver.contact.eps1"),
+        ] {
+            let e = with(extra);
+            assert_eq!(e.line, Some(line), "{e}");
+            assert!(e.message.starts_with(key), "{e}");
+        }
+        // [solver] of GOOD is at line 3, its duration at 4.
+        let e = parse_err(&GOOD.replace("duration = 0.5", "duration = 0.5\nmax_time_step = 1e-8"));
+        assert_eq!(e.line, Some(5), "{e}");
+        let e = parse_err(&GOOD.replace("duration = 0.5", "duration = 1e6"));
+        assert_eq!(e.line, Some(4), "{e}");
+        assert!(e.message.contains("1e8 steps"), "{e}");
+        let e = parse_err(&GOOD.replace("duration = 0.5", "max_time_step = 1e-7"));
+        assert_eq!(e.line, Some(4), "the default duration: Δt_max's line: {e}");
+        let e = parse_err(&GOOD.replace("poisson_ratio = 0.25", "poisson_ratio = 0.5"));
+        assert_eq!(e.line, Some(8), "{e}");
+        let e = parse_err(&GOOD.replace("density = 2750.0", "density = -1e308"));
+        assert_eq!(
+            (e.line, e.message.ends_with("got -1e308")),
+            (Some(6), true),
+            "{e}"
+        );
+    }
+
+    /// A message is one line whatever a name holds.
+    #[test]
+    fn names_with_control_characters_stay_on_one_line() {
+        let e = parse_err(&GOOD.replace("name = \"top\"", "name = \"a\\nb\"\nfixed = 3"));
+        assert!(!e.to_string().contains('\n'), "{e}");
+        let e = parse_err(
+            &GOOD
+                .replace("\"base\"", "\"x\\ny\"")
+                .replace("\"top\"", "\"x\\ny\""),
+        );
+        assert_eq!(e.to_string().lines().count(), 1, "{e}");
+        assert!(e.to_string().contains("'x\\ny' is used twice"), "{e}");
+    }
+
+    /// The README's input limits state the numbers of this module.
+    #[test]
+    fn the_readme_states_the_scene_limits() {
+        let readme = include_str!("../../README.md");
+        let limits = readme.split("### Input limits").nth(1).unwrap();
+        let spaced = |n: usize| {
+            let s = n.to_string();
+            let (head, tail) = s.split_at(s.len() - 3);
+            format!("{head} {tail}")
+        };
+        for needle in [
+            format!("| scene file | {} MiB", MAX_FILE_BYTES >> 20),
+            format!("| blocks | {} per scene", spaced(MAX_BLOCKS)),
+            format!("| points per block | {}", spaced(MAX_BLOCK_POINTS)),
+            format!("1 ≤ N ≤ {}", spaced(crate::generate::MAX_WALL_BLOCKS)),
+        ] {
+            assert!(limits.contains(&needle), "README lacks {needle}");
+        }
     }
 }

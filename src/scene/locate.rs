@@ -1,0 +1,91 @@
+//! Where things sit in the scene text, for messages: the line of an offset, the line of a key
+//! that a check after parsing rejects (`solver.contact.beta`, `materials.rock.density`), and the
+//! key of a value that serde rejected. serde's own errors carry an offset but not always the key;
+//! the checks after parsing know the key but not the offset. Both are found in toml's
+//! span-keeping parse of the text, made again only on the way to an error.
+
+use toml::de::{DeTable, DeValue};
+
+/// The 1-based line of a byte offset.
+pub(super) fn line_of(text: &str, offset: usize) -> usize {
+    let end = offset.min(text.len());
+    text.as_bytes()[..end]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// The line of the value of `path` (`["solver", "contact", "beta"]`), if the text sets it.
+pub(super) fn key_line(text: &str, path: &[&str]) -> Option<usize> {
+    let doc = DeTable::parse(text).ok()?;
+    let (first, rest) = path.split_first()?;
+    let mut value = doc.get_ref().get(*first)?;
+    for part in rest {
+        value = value.get_ref().get(*part)?;
+    }
+    Some(line_of(text, value.span().start))
+}
+
+/// The dotted key of the value, not a table, whose text contains `offset`: the key of a value
+/// serde rejected (`solver.gravity`, `blocks[2].velocity`). None where the offset lies in no such
+/// value (a key serde did not expect, a table that lacks a key): those messages name the key
+/// themselves.
+pub(super) fn key_at(text: &str, offset: usize) -> Option<String> {
+    let doc = DeTable::parse(text).ok()?;
+    find_value(doc.get_ref(), offset, "")
+}
+
+/// Depth first through the tables and arrays of tables: a table's span is its header alone.
+fn find_value(table: &DeTable<'_>, offset: usize, prefix: &str) -> Option<String> {
+    for (name, value) in table.iter() {
+        let key = format!("{prefix}{}", name.get_ref());
+        let found = match value.get_ref() {
+            DeValue::Table(t) => find_value(t, offset, &format!("{key}.")),
+            DeValue::Array(items)
+                if !items.is_empty() && items.iter().all(|i| i.get_ref().is_table()) =>
+            {
+                items.iter().enumerate().find_map(|(k, item)| {
+                    let t = item.get_ref().as_table()?;
+                    find_value(t, offset, &format!("{key}[{k}]."))
+                })
+            }
+            _ => value.span().contains(&offset).then_some(key),
+        };
+        if found.is_some() {
+            return found;
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TEXT: &str = "name = \"x\"\n[solver]\nduration = 2.0\ngravity = [0, 0, -9.8, 1]\n\
+                        [solver.contact]\nbeta = 0.25\n[materials.rock]\ndensity = 1.0\n\
+                        [[blocks]]\nname = \"a\"\n[[blocks]]\nname = \"b\"\nvelocity = [1, 2, 3, 4]\n";
+
+    #[test]
+    fn keys_have_lines_and_values_have_keys() {
+        assert_eq!(key_line(TEXT, &["solver", "duration"]), Some(3));
+        assert_eq!(key_line(TEXT, &["solver", "contact", "beta"]), Some(6));
+        assert_eq!(key_line(TEXT, &["materials", "rock", "density"]), Some(8));
+        assert_eq!(key_line(TEXT, &["solver", "max_time_step"]), None);
+        assert_eq!(key_line(TEXT, &["joint", "cohesion"]), None);
+        let at = |needle: &str| key_at(TEXT, TEXT.find(needle).unwrap());
+        assert_eq!(at("-9.8").as_deref(), Some("solver.gravity"));
+        assert_eq!(at("2.0").as_deref(), Some("solver.duration"));
+        assert_eq!(at("[1, 2, 3, 4]").as_deref(), Some("blocks[1].velocity"));
+        assert_eq!(at("\"b\"").as_deref(), Some("blocks[1].name"));
+        // Dotted keys and inline tables are the same tables.
+        let inline = "solver.contact = { beta = 7 }\n";
+        assert_eq!(
+            key_at(inline, inline.find('7').unwrap()).as_deref(),
+            Some("solver.contact.beta")
+        );
+        assert_eq!(line_of("a\nb\nc", 4), 3);
+        assert_eq!(line_of("a", 99), 1);
+    }
+}

@@ -1,0 +1,500 @@
+//! Issue #13, the input half: no input is silently cut short, run for ever or read without end.
+//! Families of bad values for every bounded input, each through the binary: exit status 2, one
+//! line on stderr naming the file, the TOML line and the key (or the flag), no panic.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_dda3d"));
+    // bench's default scene is relative to the repository.
+    c.current_dir(env!("CARGO_MANIFEST_DIR"));
+    c
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("dda3d-limits-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// One block on nothing, with `extra` appended to its `[[blocks]]` entry (line 9 onwards).
+fn scene(extra: &str) -> String {
+    format!(
+        "[materials.rock]\ndensity = 2750.0\nyoung_modulus = 2.0e10\npoisson_ratio = 0.25\n\
+         [[blocks]]\nname = \"a\"\nmaterial = \"rock\"\n\
+         box = {{ size = [1, 1, 1], center = [0, 0, 0.5] }}\n{extra}"
+    )
+}
+
+/// The block of [`scene`] with its shape given by `shape` (line 8) instead of the box.
+fn shaped(shape: &str) -> String {
+    scene("").replace("box = { size = [1, 1, 1], center = [0, 0, 0.5] }", shape)
+}
+
+/// stderr of a failed command, checked to be one line with exit status 2 and no panic.
+fn one_line_error(out: &Output, what: &str) -> String {
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "{what}: {err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{what}: one line: {err}");
+    assert!(err.starts_with("error: "), "{what}: {err}");
+    assert!(
+        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
+        "{what}: {err}"
+    );
+    err
+}
+
+/// `dda3d run` on `text` written to `NAME.toml`: the one-line error, which names the file.
+fn run_error(dir: &Path, text: &str, what: &str) -> String {
+    let path = dir.join("bad.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = bin()
+        .arg("run")
+        .arg(&path)
+        .args(["--quiet", "--out"])
+        .arg(dir.join("o"))
+        .output()
+        .unwrap();
+    let err = one_line_error(&out, what);
+    assert!(err.contains("bad.toml: "), "{what}: names the file: {err}");
+    err
+}
+
+/// Lists of the wrong length, in every field that takes one.
+#[test]
+fn lists_of_numbers_take_exactly_their_length() {
+    let dir = tmp("arity");
+    let lists = |n: usize| format!("[{}]", vec!["0.5"; n].join(", "));
+    let million = lists(1_000_000);
+    for n in [0, 1, 2, 4, 5, 1000] {
+        let l = lists(n);
+        let cases = [
+            (scene(&format!("velocity = {l}\n")), 9, "blocks[0].velocity"),
+            (
+                scene(&format!("angular_velocity = {l}\n")),
+                9,
+                "blocks[0].angular_velocity",
+            ),
+            (
+                scene(&format!("loads = [{{ point = {l}, force = [0, 0, 1] }}]\n")),
+                9,
+                "blocks[0].loads[0].point",
+            ),
+            (
+                scene(&format!("loads = [{{ point = [0, 0, 0], force = {l} }}]\n")),
+                9,
+                "blocks[0].loads[0].force",
+            ),
+            (
+                format!("[solver]\ngravity = {l}\n{}", scene("")),
+                2,
+                "solver.gravity",
+            ),
+            (
+                shaped(&format!("box = {{ size = {l}, center = [0, 0, 0.5] }}")),
+                8,
+                "blocks[0].box.size",
+            ),
+            (
+                shaped(&format!("box = {{ size = [1, 1, 1], center = {l} }}")),
+                8,
+                "blocks[0].box.center",
+            ),
+            (
+                shaped(&format!(
+                    "box = {{ size = [1, 1, 1], center = [0, 0, 0], rotation = {l} }}"
+                )),
+                8,
+                "blocks[0].box.rotation",
+            ),
+            (
+                shaped(&format!("dodecahedron = {{ edge = 1, center = {l} }}")),
+                8,
+                "blocks[0].dodecahedron.center",
+            ),
+            (
+                shaped(&format!("vertices = [[0,0,0],[1,0,0],[0,1,0],{l},[0,0,1]]")),
+                8,
+                "blocks[0].vertices",
+            ),
+            (
+                shaped(&format!(
+                    "prism = {{ base = [[0,0,0],[1,0,0],{l}], extrude = [0, 0, 1] }}"
+                )),
+                8,
+                "blocks[0].prism.base",
+            ),
+            (
+                shaped(&format!(
+                    "prism = {{ base = [[0,0,0],[1,0,0],[0,1,0]], extrude = {l} }}"
+                )),
+                8,
+                "blocks[0].prism.extrude",
+            ),
+        ];
+        for (text, line, key) in cases {
+            let what = format!("{key} of {n}");
+            let err = run_error(&dir, &text, &what);
+            assert!(
+                err.contains(&format!("line {line}: {key}: expected 3 numbers, got {n}")),
+                "{what}: {err}"
+            );
+        }
+    }
+    // The issue's examples: a vertex of four numbers, a gravity of four, a velocity of 10⁶.
+    let err = run_error(
+        &dir,
+        &shaped("vertices = [[0,0,0],[1,0,0],[0,1,0],[0,-1,0,99],[0,0,1]]"),
+        "vertex",
+    );
+    assert!(err.contains("got 4"), "{err}");
+    let err = run_error(&dir, &scene(&format!("velocity = {million}\n")), "10⁶");
+    assert!(err.contains("got 1000000") && err.len() < 200, "{err}");
+}
+
+/// Zero-length, never-ending and absurd time controls, in the scene file: each names its key
+/// and its line, with the number short.
+#[test]
+fn absurd_time_controls_in_the_scene_are_rejected_at_their_line() {
+    let dir = tmp("controls");
+    let with = |key: &str, value: &str| format!("[solver]\n{key} = {value}\n{}", scene(""));
+    let families: [(&str, &[&str]); 3] = [
+        (
+            "max_time_step",
+            &[
+                "0.0", "-1.0", "1e-15", "9.9e-8", "1.5", "1e9", "2e9", "3e9", "1e308", "nan",
+                "inf", "-inf",
+            ],
+        ),
+        (
+            "duration",
+            &[
+                "0.0", "-1.0", "1e-300", "1e-12", "9e-8", "1.1e7", "1e308", "nan", "inf",
+            ],
+        ),
+        (
+            "max_displacement_ratio",
+            &["0.0", "-0.01", "1e-12", "9e-8", "0.11", "1.0", "1e300"],
+        ),
+    ];
+    for (key, values) in families {
+        for value in values {
+            let what = format!("{key} = {value}");
+            let err = run_error(&dir, &with(key, value), &what);
+            assert!(
+                err.contains(&format!("line 2: solver.{key} must")),
+                "{what}: {err}"
+            );
+            // Short numbers: no run of digits from printing 1e308 in full.
+            let message = err.split("bad.toml: ").nth(1).unwrap();
+            assert!(message.len() < 100, "{what}: {err}");
+        }
+    }
+    let err = run_error(&dir, &with("max_time_step", "3e9"), "3e9");
+    assert!(
+        err.ends_with("must lie in [1e-7, 1] s, got 3e9 s\n"),
+        "{err}"
+    );
+    let err = run_error(&dir, &with("duration", "1e308"), "1e308");
+    assert!(err.ends_with("got 1e308 s\n"), "{err}");
+    // More steps than the limit: at the duration's line, or Δt_max's when the duration is the
+    // default.
+    for (text, line) in [
+        (
+            format!(
+                "[solver]\nduration = 1e6\nmax_time_step = 0.01\n{}",
+                scene("")
+            ),
+            2,
+        ),
+        (format!("[solver]\nmax_time_step = 1e-7\n{}", scene("")), 2),
+        (
+            format!(
+                "[solver]\n\nmax_time_step = 1e-6\nduration = 100\n{}",
+                scene("")
+            ),
+            4,
+        ),
+    ] {
+        let err = run_error(&dir, &text, "steps");
+        assert!(
+            err.contains(&format!("line {line}: solver.duration = "))
+                && err.contains("more than the limit of 1e7"),
+            "{err}"
+        );
+    }
+    // The contact tolerances and iteration caps of the same table.
+    for (table, key, value) in [
+        ("solver.contact", "eps1", "1.0"),
+        ("solver.contact", "eps2", "1e300"),
+        ("solver.contact", "max_alm_iterations", "4294967295"),
+        ("solver.contact", "max_open_close_iterations", "0"),
+        ("solver.contact", "close_threshold", "0.5"),
+        ("solver.contact", "open_threshold", "1e308"),
+        ("joint", "friction_angle", "90.0"),
+        ("solver", "equilibrium_max_steps", "1000001"),
+    ] {
+        let text = format!("{}[{table}]\n\n{key} = {value}\n", scene(""));
+        let err = run_error(&dir, &text, key);
+        assert!(
+            err.contains(&format!("line 11: {table}.{key} must")),
+            "{key}: {err}"
+        );
+    }
+}
+
+/// The scene's time controls overridden on the command line: the same bounds, and the message
+/// names the flag.
+#[test]
+fn absurd_overrides_are_rejected_naming_the_flag() {
+    let dir = tmp("flags");
+    let path = dir.join("ok.toml");
+    std::fs::write(&path, scene("")).unwrap();
+    let run = |flag: &str, value: &str| {
+        bin()
+            .arg("run")
+            .arg(&path)
+            .args([flag, value, "--quiet", "--out"])
+            .arg(dir.join("o"))
+            .output()
+            .unwrap()
+    };
+    for (flag, values) in [
+        (
+            "--duration",
+            &["-1", "0", "1e-300", "1e-12", "1e308", "1e6", "inf", "nan"][..],
+        ),
+        (
+            "--max-time-step",
+            &["-1", "0", "1e-15", "1.5", "3e9", "1e308"],
+        ),
+        ("--spectral-radius", &["-1", "0", "0.3", "1.01", "1e308"]),
+    ] {
+        for value in values {
+            let what = format!("{flag} {value}");
+            let err = one_line_error(&run(flag, value), &what);
+            assert!(err.starts_with(&format!("error: {flag}")), "{what}: {err}");
+            assert!(err.len() < 160, "{what}: {err}");
+        }
+    }
+    // Messages that were already good keep their words.
+    let err = one_line_error(&run("--duration", "-1"), "-1");
+    assert_eq!(
+        err,
+        "error: --duration must be a positive number of seconds, got -1\n"
+    );
+    let err = one_line_error(&run("--duration", "1e308"), "1e308");
+    assert_eq!(
+        err,
+        "error: --duration: solver.duration must lie in [1e-7, 1e7] s, got 1e308 s\n"
+    );
+    let err = one_line_error(&run("--duration", "1e6"), "steps");
+    assert!(
+        err.contains("1e8 steps, more than the limit of 1e7"),
+        "{err}"
+    );
+    // At the ends of the ranges a run goes: ten steps of the shortest Δt_max, one of the longest.
+    for args in [
+        ["--max-time-step", "1e-7", "--duration", "1e-6"],
+        ["--max-time-step", "1", "--duration", "1e-7"],
+    ] {
+        let out = bin()
+            .arg("run")
+            .arg(&path)
+            .args(args)
+            .args(["--quiet", "--out"])
+            .arg(dir.join("o"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let summary = std::fs::read_to_string(dir.join("o/summary.json")).unwrap();
+        assert!(!summary.contains("\"steps\": 0,"), "{args:?}: {summary}");
+    }
+}
+
+/// Scene files: a bounded read, UTF-8 with the line of the first bad byte.
+#[test]
+fn files_are_read_within_bounds() {
+    let dir = tmp("files");
+    let run = |path: &Path| bin().arg("run").arg(path).output().unwrap();
+    // A sparse file just over the limit, and an endless device.
+    let big = dir.join("big.toml");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len((16 << 20) + 1)
+        .unwrap();
+    let err = one_line_error(&run(&big), "big");
+    assert!(
+        err.contains("big.toml: the file is 16777217 bytes, more than the limit of 16 MiB"),
+        "{err}"
+    );
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(1 << 34)
+        .unwrap();
+    let err = one_line_error(&run(&big), "16 GiB");
+    assert!(err.contains("the file is 16380 MiB"), "{err}");
+    if Path::new("/dev/zero").exists() {
+        let err = one_line_error(&run(Path::new("/dev/zero")), "/dev/zero");
+        assert!(
+            err.contains("/dev/zero: ") && err.contains("16 MiB"),
+            "{err}"
+        );
+    }
+    let err = one_line_error(&run(&dir), "a directory");
+    assert!(err.contains("cannot read"), "{err}");
+    // A bad byte on line 1, 3 and 12, at the start, middle and end of a line.
+    for (line, column) in [(1, 1), (3, 5), (9, 1), (12, 1)] {
+        let mut text = scene("velocity = [0, 0, 0]\n\n\n").into_bytes();
+        let start: usize = text
+            .split(|&b| b == b'\n')
+            .take(line - 1)
+            .map(|l| l.len() + 1)
+            .sum();
+        text.insert(start + column - 1, 0xff);
+        let path = dir.join("utf8.toml");
+        std::fs::write(&path, &text).unwrap();
+        let err = one_line_error(&run(&path), "utf-8");
+        assert!(
+            err.contains(&format!(
+                "utf8.toml: line {line}: not UTF-8 text: byte 0xff at column {column}"
+            )),
+            "{err}"
+        );
+    }
+}
+
+/// Blocks and points per block: at most 100 000 of each.
+#[test]
+fn blocks_and_points_are_bounded() {
+    let dir = tmp("counts");
+    let mut text = scene("").split("[[blocks]]").next().unwrap().to_string();
+    for k in 0..100_001 {
+        text += &format!(
+            "[[blocks]]\nname = \"b{k}\"\nmaterial = \"rock\"\n\
+             box = {{ size = [1, 1, 1], center = [{}, 0, 0.5] }}\n",
+            2 * k
+        );
+    }
+    let err = run_error(&dir, &text, "blocks");
+    // The first block over the limit starts at line 5 + 4·100 000.
+    assert!(
+        err.contains("line 400005: 100001 blocks, more than the limit of 100000"),
+        "{err}"
+    );
+    for n in [100_001, 250_000] {
+        let points: Vec<String> = (0..n)
+            .map(|k| {
+                let a = k as f64 * 1e-3;
+                format!("[{}, {}, {}]", a.cos(), a.sin(), (k % 7) as f64)
+            })
+            .collect();
+        let err = run_error(
+            &dir,
+            &shaped(&format!("vertices = [{}]", points.join(","))),
+            "vertices",
+        );
+        assert!(
+            err.contains(&format!(
+                "line 5: block 'a': vertices: {n} points, more than the limit of 100000"
+            )),
+            "{err}"
+        );
+        let base: Vec<String> = (0..n / 2 + 1)
+            .map(|k| {
+                let a = k as f64 * 1e-4;
+                format!("[{}, {}, 0]", a.cos(), a.sin())
+            })
+            .collect();
+        let err = run_error(
+            &dir,
+            &shaped(&format!(
+                "prism = {{ base = [{}], extrude = [0, 0, 1] }}",
+                base.join(",")
+            )),
+            "prism",
+        );
+        assert!(err.contains("prism: a base of"), "{err}");
+    }
+}
+
+/// `generate` writes only scenes that load, and `bench` checks its sizes before it builds any.
+#[test]
+fn generate_and_bench_options_are_bounded() {
+    let dir = tmp("gen");
+    let out = dir.join("w.toml");
+    for blocks in ["0", "99999", "1000000", "-5", "18446744073709551615"] {
+        let o = bin()
+            .args(["generate", "column", "--blocks", blocks, "--out"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = one_line_error(&o, blocks);
+        assert!(err.contains("--blocks"), "{err}");
+    }
+    let o = bin()
+        .args(["generate", "column", "--layers", "0", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    one_line_error(&o, "layers 0");
+    assert!(!out.exists(), "nothing written");
+    for (flag, value) in [
+        ("--sizes", "0"),
+        ("--sizes", "10,0"),
+        ("--sizes", "1000000000"),
+        ("--sizes", "99999"),
+        ("--sizes", "-1"),
+        ("--standing-sizes", "0"),
+        ("--standing-sizes", "100000"),
+        ("--repeat", "0"),
+        ("--repeat", "101"),
+        ("--repeat", "-1"),
+        ("--scaling-duration", "-1"),
+        ("--scaling-duration", "0"),
+        ("--scaling-duration", "1e308"),
+        ("--scaling-duration", "1e6"),
+    ] {
+        let o = bin().args(["bench", flag, value]).output().unwrap();
+        let err = one_line_error(&o, &format!("{flag} {value}"));
+        assert!(err.contains(flag), "{flag} {value}: {err}");
+        assert!(o.stdout.is_empty(), "{flag} {value}: nothing run");
+    }
+}
+
+/// The argument parser's own errors are one line too.
+#[test]
+fn usage_errors_are_one_line() {
+    for args in [
+        &["run", "x.toml", "--durration", "5"][..],
+        &["run", "x.toml", "--duration", "abc"],
+        &["run", "x.toml", "--duration"],
+        &["run", "x.toml", "--method", "magic"],
+        &["run"],
+        &["frobnicate"],
+        &["generate", "column", "--blocks", "many"],
+        &["bench", "--sizes", "1,x"],
+    ] {
+        let o = bin().args(args).output().unwrap();
+        one_line_error(&o, &format!("{args:?}"));
+    }
+    let o = bin()
+        .args(["run", "x.toml", "--durration", "5"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("(tip: a similar argument exists: '--duration')"),
+        "{err}"
+    );
+    // Help is still help.
+    let o = bin().args(["run", "--help"]).output().unwrap();
+    assert!(o.status.success());
+    assert!(String::from_utf8_lossy(&o.stdout).contains("--max-time-step"));
+}
