@@ -16,14 +16,34 @@ use crate::physics::mechanics::Material;
 #[serde(deny_unknown_fields)]
 pub(super) struct SceneFile {
     pub(super) name: Option<String>,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub(super) solver: SolverParams,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "table")]
     pub(super) joint: JointParams,
     #[serde(default)]
     pub(super) materials: BTreeMap<String, Spanned<Material>>,
     #[serde(default)]
     pub(super) blocks: Vec<Spanned<BlockSpec>>,
+}
+
+/// Reads a field that must be a table. serde lets a struct be read from a list of its fields in
+/// order, so `solver = []` was a solver with every default, silently (#13's fuzz test).
+fn table<'de, D, T>(d: D) -> Result<T, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    struct OnlyTable<T>(std::marker::PhantomData<T>);
+    impl<'de, T: Deserialize<'de>> serde::de::Visitor<'de> for OnlyTable<T> {
+        type Value = T;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a table")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(self, map: A) -> Result<T, A::Error> {
+            T::deserialize(serde::de::value::MapAccessDeserializer::new(map))
+        }
+    }
+    d.deserialize_map(OnlyTable(std::marker::PhantomData))
 }
 
 /// One `[[blocks]]` entry. Exactly one of `vertices`, `box`, `dodecahedron`, `prism`.
