@@ -1,6 +1,6 @@
 //! The `dda3d` binary's front end: parses the command line, checks the options, loads the scene
 //! and hands over to the library, then turns any failure into one line on stderr and an exit
-//! status (2 for bad input, 1 for a run that failed).
+//! status ([`exit`] has the table: 1 only for a diverged run, 2 for bad input, 74 for I/O).
 //!
 //! One file per subcommand, each with its clap arguments and its entry function:
 //! [`run`](run()) (headless simulation), [`render`](render()) (PNG frames), [`generate`](generate())
@@ -87,7 +87,8 @@ pub struct SolverOverrides {
 pub enum CliError {
     /// Bad input: exit status 2.
     Input(String),
-    /// The run failed (diverged, I/O): exit status 1.
+    /// The run failed: exit status 1 here; `main_entry` gets the finer status (diverged 1,
+    /// I/O 74, other failures 70) from `run` and `render` themselves (see [`exit`]).
     Run(String),
 }
 

@@ -93,8 +93,7 @@ pub const MAX_DISPLACEMENT_RATIO: Param = Param {
     valid: Interval::new(Bound::Closed(1e-7), Bound::Closed(0.1)),
     valid_why: "Shi advises 0.001–0.01. Above 0.1 a step may move a vertex a tenth of w0 and \
           contacts are searched 2·δ·w0 away, a tenth of the model's extent; below 10⁻⁷ a whole \
-          step moves less than the open–close hysteresis f0 = 2·10⁻⁷ w0 (a generated wall of 99 \
-          998 blocks uses 5·10⁻⁷).",
+          step moves less than the open–close hysteresis f0 = 2·10⁻⁷ w0.",
     widget: absolute(1e-4, 0.1, true),
 };
 
