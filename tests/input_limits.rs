@@ -498,3 +498,20 @@ fn usage_errors_are_one_line() {
     assert!(o.status.success());
     assert!(String::from_utf8_lossy(&o.stdout).contains("--max-time-step"));
 }
+
+#[test]
+fn a_bench_scene_that_does_not_load_is_bad_input() {
+    let dir = tmp("bench-scene");
+    let path = dir.join("bad.toml");
+    for text in ["bogus = 1\n", &scene("fixed = 3\n")] {
+        std::fs::write(&path, text).unwrap();
+        let out = bin()
+            .arg("bench")
+            .arg("--scene")
+            .arg(&path)
+            .output()
+            .unwrap();
+        let err = one_line_error(&out, text);
+        assert!(err.contains("bad.toml"), "{err}");
+    }
+}

@@ -42,6 +42,8 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
             args.scene.display()
         )));
     }
+    // A scene that does not load is bad input (exit 2), not a failed benchmark.
+    crate::scene::load(&args.scene).map_err(|e| CliError::Input(e.to_string()))?;
     crate::bench::run(
         &args.scene,
         &args.sizes,
