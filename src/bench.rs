@@ -2,6 +2,10 @@
 //! generated walls. Timings are wall-clock on whatever machine runs it; the README quotes the
 //! figures measured on the 2-core CI machine.
 
+mod cutting;
+
+pub use cutting::cut_table;
+
 use std::path::Path;
 use std::time::Instant;
 

@@ -8,6 +8,7 @@
 //! Data flows one way:
 //!
 //! ```text
+//! rockmass ─┐
 //! scene ──▶ model ──▶ solver (activate → assemble → ALM / open–close → step control → commit)
 //!                        │  uses physics (geometry, mechanics, linear) and contact
 //!                        ▼
@@ -27,6 +28,7 @@ pub mod output;
 pub mod params;
 pub mod physics;
 pub mod render;
+pub mod rockmass;
 pub mod scene;
 pub mod snapshot;
 pub mod solver;

@@ -13,6 +13,23 @@ use crate::physics::geometry::{
 use crate::physics::integrator::Kinematics;
 use crate::physics::mechanics::{Mat12, Material, Vec12, elasticity_matrix, mass_matrix};
 
+/// A face of a block that lies on a joint plane of a rock mass: the set (an index of
+/// [`crate::params::SolverParams::joint_sets`]) and the plane within it. Two blocks touching
+/// across faces with the same tag touch across that joint, and take its set's properties.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct JointFace {
+    pub set: u16,
+    pub plane: u32,
+}
+
+/// Where a block cut from a rock mass came from: the rock mass (an index of
+/// [`Model::rock_masses`]) and the region of its domain.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RockMassOf {
+    pub mass: u16,
+    pub region: u16,
+}
+
 /// One deformable block and its state carried between steps.
 #[derive(Clone, Debug)]
 pub struct Block {
@@ -45,6 +62,10 @@ pub struct Block {
     pub initial_centroid: Vec3,
     pub lo: Vec3,
     pub hi: Vec3,
+    /// The joint plane each face lies on, if any (faces of blocks cut from a rock mass).
+    pub face_joints: Vec<Option<JointFace>>,
+    /// The rock mass the block was cut from, if any.
+    pub rock_mass: Option<RockMassOf>,
 }
 
 impl Block {
@@ -86,7 +107,10 @@ impl Block {
             initial_centroid: mp.centroid,
             lo: Vec3::zeros(),
             hi: Vec3::zeros(),
+            face_joints: Vec::new(),
+            rock_mass: None,
         };
+        b.face_joints = vec![None; b.topo.faces.len()];
         b.refresh();
         b
     }
@@ -139,4 +163,17 @@ impl Block {
 pub struct Model {
     pub name: String,
     pub blocks: Vec<Block>,
+    /// The names of the rock masses the blocks were cut from ([`Block::rock_mass`]).
+    pub rock_masses: Vec<String>,
+}
+
+impl Model {
+    /// A model of hand-made blocks (no rock masses).
+    pub fn new(name: impl Into<String>, blocks: Vec<Block>) -> Self {
+        Model {
+            name: name.into(),
+            blocks,
+            rock_masses: Vec::new(),
+        }
+    }
 }

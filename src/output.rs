@@ -171,6 +171,7 @@ impl RunWriter {
                 "penetration",
                 "penalty",
                 "lambda",
+                "joint",
             ],
         )?;
         Ok(RunWriter {
@@ -228,6 +229,10 @@ impl RunWriter {
                 f(c.penetration),
                 f(c.penalty),
                 f(c.lambda),
+                c.joint
+                    .and_then(|k| s.joint_sets.get(usize::from(k)))
+                    .cloned()
+                    .unwrap_or_default(),
             ])?;
         }
         self.staged_time = Some(s.time);

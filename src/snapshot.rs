@@ -66,6 +66,9 @@ pub struct BlockSnapshot {
     pub velocity: [f64; 3],
     /// Centroid displacement since t = 0, m.
     pub displacement: [f64; 3],
+    /// The rock mass the block was cut from (an index of [`Snapshot::rock_masses`]) and the
+    /// region of its domain; `None` for a hand-made block.
+    pub rock_mass: Option<(u16, u16)>,
 }
 
 #[cfg(test)]
@@ -97,6 +100,7 @@ impl BlockSnapshot {
             centroid: at.map(|x| x + size / 2.0),
             velocity: [0.0; 3],
             displacement: [0.0; 3],
+            rock_mass: None,
         }
     }
 }
@@ -124,6 +128,9 @@ pub struct ContactSnapshot {
     pub penalty: f64,
     /// Lagrange multiplier (0 in penalty mode), N.
     pub lambda: f64,
+    /// The joint set the contact lies on, an index of [`Snapshot::joint_sets`] (`None`: the
+    /// scene's `[joint]`).
+    pub joint: Option<u16>,
 }
 
 /// Per-step statistics.
@@ -192,6 +199,10 @@ pub struct Snapshot {
     pub stats: StepStats,
     /// The initial equilibrium stage, if the scene asked for one.
     pub equilibrium: Option<EquilibriumReport>,
+    /// The names of the rock masses ([`BlockSnapshot::rock_mass`]).
+    pub rock_masses: Vec<String>,
+    /// The names of the joint sets ([`ContactSnapshot::joint`]).
+    pub joint_sets: Vec<String>,
 }
 
 /// Wall time spent in the phases of the solver.

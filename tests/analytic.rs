@@ -22,13 +22,7 @@ fn single(center: [f64; 3], velocity: Vec3, spin: Vec3, params: SolverParams) ->
     );
     let (v, t) = convex_hull(&pts).unwrap();
     let b = Block::new("b".into(), ROCK, false, v, t, velocity, spin, vec![]);
-    Solver::new(
-        Model {
-            name: "single".into(),
-            blocks: vec![b],
-        },
-        params,
-    )
+    Solver::new(Model::new("single", vec![b]), params)
 }
 
 /// The constant-acceleration scheme (3.2) is exact for a constant force: a projectile must follow
@@ -63,10 +57,7 @@ fn projectile_is_exact() {
                 vec![],
             );
             s = Solver::new(
-                Model {
-                    name: "beside a wall".into(),
-                    blocks: vec![s.model.blocks[0].clone(), wall],
-                },
+                Model::new("beside a wall", vec![s.model.blocks[0].clone(), wall]),
                 s.params.clone(),
             );
         }
@@ -182,13 +173,7 @@ fn point_load_accelerates_the_centroid() {
             vec![(c + offset, force)],
         );
         let m = b.mass;
-        let mut s = Solver::new(
-            Model {
-                name: "load".into(),
-                blocks: vec![b],
-            },
-            params.clone(),
-        );
+        let mut s = Solver::new(Model::new("load", vec![b]), params.clone());
         let x0 = Vec3::from(s.snapshot().blocks[0].centroid);
         while !s.finished() {
             s.step().unwrap();

@@ -61,7 +61,7 @@ fn run_writes_the_three_outputs() {
     assert_eq!(
         lines.next(),
         Some(
-            "time,block_i,block_j,mode,state,px,py,pz,nx,ny,nz,normal_force,shear_force,penetration,penalty,lambda"
+            "time,block_i,block_j,mode,state,px,py,pz,nx,ny,nz,normal_force,shear_force,penetration,penalty,lambda,joint"
         )
     );
     let last: Vec<&str> = lines.last().unwrap().split(',').collect();

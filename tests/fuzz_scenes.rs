@@ -577,7 +577,7 @@ fn check_outputs(out: &Path, status: &str) -> Verdict {
     if let Some(l) = summary.lines().find(|l| null(l)) {
         return Err(("non-finite output", format!("summary.json: {}", l.trim())));
     }
-    let names = ["block", "block_i", "block_j", "mode", "state"];
+    let names = ["block", "block_i", "block_j", "mode", "state", "joint"];
     for file in ["blocks.csv", "contacts.csv"] {
         let csv_err = |e: csv::Error| ("bad csv", format!("{file}: {e}"));
         let mut rd = csv::Reader::from_path(out.join(file)).map_err(csv_err)?;

@@ -40,6 +40,7 @@ fn rock(name: &str, c: DVec3, a: f64, rot: DMat3, v: DVec3) -> BlockSnapshot {
         centroid: c.to_array(),
         velocity: v.to_array(),
         displacement: (v * 0.3).to_array(),
+        rock_mass: None,
     }
 }
 
@@ -75,6 +76,7 @@ fn rockfall() -> Snapshot {
                 penetration: 0.0,
                 penalty: 0.0,
                 lambda: 0.0,
+                joint: None,
             });
         }
     }
@@ -86,6 +88,8 @@ fn rockfall() -> Snapshot {
         contacts,
         stats: StepStats::default(),
         equilibrium: None,
+        rock_masses: Vec::new(),
+        joint_sets: Vec::new(),
     }
 }
 

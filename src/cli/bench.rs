@@ -27,6 +27,10 @@ pub struct BenchArgs {
     /// Simulated time of the scaling runs, s.
     #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub scaling_duration: f64,
+    /// Rock-mass cutting: boxes cut by three joint sets into about this many blocks (comma
+    /// separated, each 1..=100000).
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "1000,10000", allow_negative_numbers = true)]
+    pub cut_sizes: Vec<usize>,
 }
 
 /// The most runs per measurement: the best of 100 is as good as a minimum gets, and a bound
@@ -51,7 +55,11 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
         args.repeat,
         args.scaling_duration,
     )
-    .map_err(CliError::Run)
+    .map_err(CliError::Run)?;
+    if !args.cut_sizes.is_empty() {
+        crate::bench::cut_table(&args.cut_sizes, args.repeat).map_err(CliError::Run)?;
+    }
+    Ok(())
 }
 
 /// The wall sizes, the repeat count and the scaling runs' duration, checked before anything is
@@ -67,6 +75,16 @@ fn check_options(args: &BenchArgs) -> Result<(), String> {
                 "{flag}: each wall size must lie in 1..={MAX_WALL_BLOCKS} blocks, got {n}"
             ));
         }
+    }
+    if let Some(n) = args
+        .cut_sizes
+        .iter()
+        .find(|n| !(1..=crate::scene::MAX_BLOCKS).contains(n))
+    {
+        return Err(format!(
+            "--cut-sizes: each size must lie in 1..={} blocks, got {n}",
+            crate::scene::MAX_BLOCKS
+        ));
     }
     if !(1..=MAX_REPEAT).contains(&args.repeat) {
         return Err(format!(

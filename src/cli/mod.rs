@@ -4,10 +4,12 @@
 //!
 //! One file per subcommand, each with its clap arguments and its entry function:
 //! [`run`](run()) (headless simulation), [`render`](render()) (PNG frames), [`generate`](generate())
-//! (scene files), [`bench`](bench()) and [`view`](view()) (the interactive viewer). The command
+//! (scene files), [`cut`](cut()) (rock masses to blocks), [`bench`](bench()) and [`view`](view())
+//! (the interactive viewer). The command
 //! line is a contract: flags, defaults, help texts and exit statuses stay as they are.
 
 mod bench;
+mod cut;
 pub mod exit;
 mod generate;
 mod render;
@@ -26,6 +28,7 @@ use crate::scene::{self, Scene, SceneError};
 use crate::text::short;
 
 pub use bench::{BenchArgs, bench};
+pub use cut::{CutArgs, cut};
 pub use generate::{GenerateArgs, GeneratedKind, generate};
 pub use render::{RenderArgs, render};
 pub use run::{Progress, RunArgs, run};
@@ -50,6 +53,9 @@ pub enum CliCommand {
     Render(RenderArgs),
     /// Write a generated scene file (for measuring cost as the model grows).
     Generate(GenerateArgs),
+    /// Cut the scene's rock masses into blocks: write the scene with explicit [[blocks]] and
+    /// print the blocks, volumes and slivers of each.
+    Cut(CutArgs),
     /// Time the rockfall scene with both methods, and the scaling on generated walls.
     Bench(BenchArgs),
     /// Open the interactive viewer (`dda3d SCENE.toml` is short for `dda3d view SCENE.toml`).
@@ -174,6 +180,7 @@ pub fn dispatch(cli: &Cli) -> Result<(), CliError> {
         CliCommand::Run(args) => run(args),
         CliCommand::Render(args) => render(args),
         CliCommand::Generate(args) => generate(args),
+        CliCommand::Cut(args) => cut(args),
         CliCommand::Bench(args) => bench(args),
         CliCommand::View(args) => view(args),
     }
@@ -191,7 +198,7 @@ pub fn main_entry() -> ExitCode {
     let result = match &cli.command {
         CliCommand::Run(args) => run::execute(args),
         CliCommand::Render(args) => render::execute(args),
-        CliCommand::Generate(_) => {
+        CliCommand::Generate(_) | CliCommand::Cut(_) => {
             dispatch(&cli).map_err(|e| exit::Failure::from_cli(e, exit::Failure::Io))
         }
         CliCommand::View(_) => {

@@ -38,7 +38,8 @@ pub struct RenderArgs {
     /// Point the camera looks at, m: `x,y,z` (default: the centre of the framed box).
     #[arg(long, allow_hyphen_values = true, value_delimiter = ',', num_args = 1)]
     pub target: Option<Vec<f64>>,
-    /// Block colours: block (one colour per block), velocity, displacement.
+    /// Block colours: block (one colour per block), velocity, displacement, rock-mass (a colour
+    /// per rock mass, shaded per region and block).
     #[arg(long, default_value = "block")]
     pub color: String,
     /// Force arrow scale in N per metre of arrow (default: automatic, fixed after frame 0).

@@ -31,6 +31,9 @@ pub struct LawParams {
     pub slip_tolerance: f64,
     /// tan φ of the joint.
     pub tan_phi: f64,
+    /// Joints held against sliding (the equilibrium stage's first phase): a locked contact
+    /// stays locked whatever its shear; it can still open.
+    pub held: bool,
     /// ε2 of (P24): a held friction counts as below the capacity λ tan φ only by more than
     /// this fraction (the multipliers themselves are converged to ε2).
     pub eps2: f64,
@@ -91,6 +94,7 @@ pub fn classify(o: &Observation, p: &LawParams) -> Transition {
             }
         }
         _ if o.normal_force < -p.open_tension => Transition::Open,
+        ContactState::Lock if p.held => Transition::Keep,
         ContactState::Lock => {
             let extension = o.shear.norm();
             let strength = o.normal_force * p.tan_phi + o.cohesion;
@@ -172,6 +176,7 @@ mod tests {
             open_tension: 100.0,
             slip_tolerance: 1e-6,
             tan_phi: 35f64.to_radians().tan(),
+            held: false,
             eps2: 0.01,
         }
     }
@@ -190,6 +195,25 @@ mod tests {
             held_friction: None,
             slid_before: true,
         }
+    }
+
+    /// Held joints (the equilibrium stage): a locked contact does not slide under any shear,
+    /// but still opens in tension.
+    #[test]
+    fn held_joints_do_not_slide_but_open() {
+        let p = LawParams {
+            held: true,
+            ..law()
+        };
+        let mut o = seen(ContactState::Lock);
+        for n in [0.0, 1e2, 1e6] {
+            o.normal_force = n;
+            o.shear = Vec3::new(1.0, 0.0, 0.0);
+            assert_eq!(classify(&o, &p), Transition::Keep, "N = {n}");
+            assert!(matches!(classify(&o, &law()), Transition::Slide { .. }));
+        }
+        o.normal_force = -1e3;
+        assert_eq!(classify(&o, &p), Transition::Open);
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //!
 //! - [`detection`]: which features of which block pairs may touch in this step;
 //! - [`kinematics`]: the linearised normal distance and the contact submatrices;
+//! - [`joint`]: which joint set a contact lies on (its friction and cohesion);
 //! - [`law`]: the contact law as a pure state classification (open / lock / slide, hysteresis,
 //!   friction reversal, cohesion);
 //! - [`record`]: what a contact carries from one step to the next.
@@ -11,6 +12,7 @@
 
 pub mod detection;
 pub mod groups;
+pub mod joint;
 pub mod kinematics;
 pub mod law;
 pub mod record;

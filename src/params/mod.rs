@@ -169,6 +169,15 @@ impl Default for JointParams {
     }
 }
 
+/// The properties of one joint set of a rock mass (`[[rock_masses.joint_sets]]`): contacts
+/// between two faces cut by the same plane of the set take these instead of `[joint]`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JointSetParams {
+    /// The set's name, as `contacts.csv` writes it.
+    pub name: String,
+    pub joint: JointParams,
+}
+
 /// All tunables of a run. The scene file's `[solver]` table, plus `[solver.contact]` and
 /// `[joint]` which live in their own tables.
 ///
@@ -213,6 +222,14 @@ pub struct SolverParams {
     /// The scene's top-level `[joint]` table (not part of `[solver]`).
     #[serde(skip)]
     pub joint: JointParams,
+    /// The joint sets of the scene's rock masses, by the index a contact carries
+    /// ([`SolverParams::joint_of`]).
+    #[serde(skip)]
+    pub joint_sets: Vec<JointSetParams>,
+    /// Every joint held against sliding: set by the solver for the first phase of the
+    /// equilibrium stage, never by a scene.
+    #[serde(skip)]
+    pub joints_held: bool,
 }
 
 impl Default for SolverParams {
@@ -233,6 +250,8 @@ impl Default for SolverParams {
             equilibrium_max_steps: 2000,
             contact: ContactParams::default(),
             joint: JointParams::default(),
+            joint_sets: Vec::new(),
+            joints_held: false,
         }
     }
 }
@@ -246,6 +265,17 @@ pub struct Invalid {
 }
 
 impl SolverParams {
+    /// The joint properties of a contact: its joint set's (`Some(index)`), or `[joint]`.
+    pub fn joint_of(&self, set: Option<u16>) -> &JointParams {
+        set.and_then(|k| self.joint_sets.get(usize::from(k)))
+            .map_or(&self.joint, |s| &s.joint)
+    }
+
+    /// Every joint in the scene: `[joint]` and each joint set's.
+    pub fn joints_mut(&mut self) -> impl Iterator<Item = &mut JointParams> {
+        std::iter::once(&mut self.joint).chain(self.joint_sets.iter_mut().map(|s| &mut s.joint))
+    }
+
     /// Checks every value against the range of its [`table`] entry, then the number of steps the
     /// run would take ([`table::MAX_STEPS`]); returns a message naming the offending key. Every
     /// number is first checked to be finite, then each against its range, both in the table's

@@ -112,6 +112,33 @@ pub fn block_color(index: usize, fixed: bool) -> Rgba {
     srgb_to_linear(hex(srgb))
 }
 
+/// Base colours of rock masses (sRGB): earth tones, one per rock mass in turn.
+pub const ROCK_MASS_SRGB: [u32; 6] = [0xC8A27A, 0x8FA6B8, 0xB7B48A, 0xB98C8C, 0x9DB59A, 0xA99ABF];
+
+/// Linear colour of block `index` of rock mass `mass`, region `region`: the rock mass's colour,
+/// its hue turned a little per region and its lightness varied per block (by a hash of the
+/// index, the same in every frame) so that neighbouring blocks stay apart; fixed blocks muted.
+pub fn rock_mass_color(mass: u16, region: u16, index: usize, fixed: bool) -> Rgba {
+    let base = hex(ROCK_MASS_SRGB[usize::from(mass) % ROCK_MASS_SRGB.len()]);
+    // Regions: rotate the colour's channels toward the next one by a fifth each.
+    let r = f32::from(region % 4) * 0.2;
+    let tinted = [
+        base[0] * (1.0 - r) + base[1] * r,
+        base[1] * (1.0 - r) + base[2] * r,
+        base[2] * (1.0 - r) + base[0] * r,
+    ];
+    // A fixed hash of the index to a lightness factor in [0.78, 1.12].
+    let h = (index as u32).wrapping_mul(2_654_435_761) >> 24;
+    let k = 0.78 + 0.34 * (h as f32 / 255.0);
+    let c = srgb_to_linear([
+        (tinted[0] * k).min(1.0),
+        (tinted[1] * k).min(1.0),
+        (tinted[2] * k).min(1.0),
+        1.0,
+    ]);
+    if fixed { desaturate(c, 0.7) } else { c }
+}
+
 /// Perceptually uniform colour map (viridis, sampled at 9 points, linear interpolation in sRGB),
 /// `t` in [0, 1] (clamped; NaN maps to 0). Returns a linear colour.
 pub fn colormap(t: f32) -> Rgba {

@@ -21,6 +21,8 @@ pub enum Coloring {
     Velocity,
     /// Magnitude of the centroid displacement since t = 0 (m), through a colour map.
     Displacement,
+    /// A colour per rock mass, shaded per region and block; hand-made blocks as `PerBlock`.
+    RockMass,
 }
 
 impl Coloring {
@@ -30,8 +32,10 @@ impl Coloring {
             "block" | "blocks" | "per-block" => Ok(Coloring::PerBlock),
             "velocity" | "speed" | "v" => Ok(Coloring::Velocity),
             "displacement" | "disp" | "u" => Ok(Coloring::Displacement),
+            "rock-mass" | "rockmass" | "mass" | "region" => Ok(Coloring::RockMass),
             other => Err(format!(
-                "unknown colouring {other:?} (expected block, velocity or displacement)"
+                "unknown colouring {other:?} (expected block, velocity, displacement or \
+                 rock-mass)"
             )),
         }
     }
@@ -249,7 +253,7 @@ impl RenderScene {
 /// value is not finite).
 fn field_value(b: &BlockSnapshot, coloring: Coloring) -> Option<f64> {
     let v = match coloring {
-        Coloring::PerBlock => return None,
+        Coloring::PerBlock | Coloring::RockMass => return None,
         Coloring::Velocity => DVec3::from_array(b.velocity).length(),
         Coloring::Displacement => DVec3::from_array(b.displacement).length(),
     };
@@ -270,7 +274,7 @@ impl FieldLegend {
     /// the largest value in the frame.
     fn for_style(snap: &Snapshot, style: &SceneStyle) -> Option<FieldLegend> {
         let (label, unit) = match style.coloring {
-            Coloring::PerBlock => return None,
+            Coloring::PerBlock | Coloring::RockMass => return None,
             Coloring::Velocity => ("speed |v|", "m/s"),
             Coloring::Displacement => ("displacement |u|", "m"),
         };
@@ -311,8 +315,11 @@ fn push_blocks(
         .edges
         .then(|| (1.4f32, srgb_to_linear(hex(EDGE_SRGB))));
     for (i, b) in snap.blocks.iter().enumerate() {
-        let color = match (field, field_value(b, style.coloring)) {
-            (Some(f), Some(v)) if !b.fixed => f.color(v),
+        let color = match (field, field_value(b, style.coloring), b.rock_mass) {
+            (Some(f), Some(v), _) if !b.fixed => f.color(v),
+            (_, _, Some((mass, region))) if style.coloring == Coloring::RockMass => {
+                mesh::rock_mass_color(mass, region, i, b.fixed)
+            }
             _ => mesh::block_color(i, b.fixed),
         };
         mesh::push_block(
@@ -487,6 +494,7 @@ mod tests {
             fixed,
             velocity: [0.0, 0.0, -2.0],
             displacement: [0.0, 0.0, -0.5],
+            rock_mass: None,
             ..BlockSnapshot::test_cube(name, at, 1.0)
         }
     }
@@ -503,6 +511,8 @@ mod tests {
             contacts,
             stats: StepStats::default(),
             equilibrium: None,
+            rock_masses: Vec::new(),
+            joint_sets: Vec::new(),
         }
     }
 
@@ -519,6 +529,7 @@ mod tests {
             penetration: 0.0,
             penalty: 0.0,
             lambda: 0.0,
+            joint: None,
         }
     }
 

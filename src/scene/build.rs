@@ -3,7 +3,7 @@
 //! alone; [`super::parse`] adds the file, the line and the block's name.
 
 use super::MAX_BLOCK_POINTS;
-use super::format::BlockSpec;
+use super::format::{BlockSpec, ShapeSpec};
 use crate::contact::Shape;
 use crate::contact::detection::broad_phase;
 use crate::model::Block;
@@ -76,7 +76,7 @@ fn finite(v: &[f64]) -> bool {
 
 /// The points whose convex hull is the block: exactly one of `vertices`, `box`,
 /// `dodecahedron` or `prism`.
-fn shape_points(spec: &BlockSpec) -> Result<Vec<Vec3>, String> {
+pub(super) fn shape_points(spec: &ShapeSpec) -> Result<Vec<Vec3>, String> {
     let given = [
         spec.vertices.is_some(),
         spec.box_.is_some(),
@@ -89,11 +89,11 @@ fn shape_points(spec: &BlockSpec) -> Result<Vec<Vec3>, String> {
     if given != 1 {
         return Err("give exactly one of vertices, box, dodecahedron or prism".into());
     }
-    if let Some(v) = &spec.vertices {
+    if let Some(v) = spec.vertices {
         check_point_count(v.len(), || format!("vertices: {} points", v.len()))?;
         return Ok(v.iter().map(|p| Vec3::from(p.0)).collect());
     }
-    if let Some(b) = &spec.box_ {
+    if let Some(b) = spec.box_ {
         if !finite(&b.size) || !finite(&b.center) || !finite(&b.rotation) {
             return Err("box has a non-finite number".into());
         }
@@ -106,7 +106,7 @@ fn shape_points(spec: &BlockSpec) -> Result<Vec<Vec3>, String> {
             &rotation_xyz_degrees(b.rotation),
         ));
     }
-    if let Some(d) = &spec.dodecahedron {
+    if let Some(d) = spec.dodecahedron {
         if !d.edge.is_finite() || !finite(&d.center) || !finite(&d.rotation) {
             return Err("dodecahedron has a non-finite number".into());
         }
@@ -119,7 +119,7 @@ fn shape_points(spec: &BlockSpec) -> Result<Vec<Vec3>, String> {
             &rotation_xyz_degrees(d.rotation),
         ));
     }
-    let p = spec.prism.as_ref().expect("one shape given");
+    let p = spec.prism.expect("one shape given");
     // The prism's vertices are its base and the base swept.
     check_point_count(2 * p.base.len(), || {
         format!(
@@ -141,7 +141,7 @@ pub(super) fn build_block(
     name: String,
     material: Material,
 ) -> Result<Block, String> {
-    let points = shape_points(spec)?;
+    let points = shape_points(&spec.shape())?;
     let (vertices, topo) = convex_hull(&points).map_err(|e| e.to_string())?;
     if !finite(&spec.velocity) || !finite(&spec.angular_velocity) {
         return Err("velocity is not finite".into());

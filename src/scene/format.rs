@@ -24,6 +24,13 @@ pub(super) struct SceneFile {
     pub(super) materials: BTreeMap<String, Spanned<Material>>,
     #[serde(default)]
     pub(super) blocks: Vec<Spanned<BlockSpec>>,
+    /// Domains cut into blocks by joint sets (`super::rock_mass`).
+    #[serde(default)]
+    pub(super) rock_masses: Vec<Spanned<RockMassSpec>>,
+    /// Joint sets given by their planes, for blocks given by their vertices: what `dda3d cut`
+    /// writes for the sets of a rock mass it has cut.
+    #[serde(default)]
+    pub(super) joint_sets: Vec<Spanned<PlanesSpec>>,
 }
 
 /// Reads a field that must be a table. serde lets a struct be read from a list of its fields in
@@ -68,6 +75,127 @@ pub(super) struct BlockSpec {
     /// Point loads moving with the block.
     #[serde(default)]
     pub(super) loads: Vec<LoadSpec>,
+    /// The rock mass a block written by `dda3d cut` was cut from: its faces on the planes of the
+    /// rock mass's `[[joint_sets]]` are joints of those sets.
+    pub(super) rock_mass: Option<String>,
+    /// The region of that rock mass's domain, from 1.
+    pub(super) region: Option<u16>,
+}
+
+impl BlockSpec {
+    pub(super) fn shape(&self) -> ShapeSpec<'_> {
+        ShapeSpec {
+            vertices: self.vertices.as_deref(),
+            box_: self.box_.as_ref(),
+            dodecahedron: self.dodecahedron.as_ref(),
+            prism: self.prism.as_ref(),
+        }
+    }
+}
+
+/// The shape of a block or a region: exactly one of these is given.
+pub(super) struct ShapeSpec<'a> {
+    pub(super) vertices: Option<&'a [Exact<3>]>,
+    pub(super) box_: Option<&'a BoxSpec>,
+    pub(super) dodecahedron: Option<&'a DodecahedronSpec>,
+    pub(super) prism: Option<&'a PrismSpec>,
+}
+
+/// One `[[rock_masses]]` entry: a domain, the joint sets that cut it, and which blocks are held.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RockMassSpec {
+    pub(super) name: String,
+    pub(super) material: String,
+    /// Convex pieces whose union is the domain.
+    pub(super) regions: Vec<Spanned<RegionSpec>>,
+    #[serde(default)]
+    pub(super) fixed: FixedSpec,
+    /// m³: blocks smaller than this after cutting are dropped (default: 10⁻³ of the median
+    /// block's volume).
+    pub(super) min_volume: Option<f64>,
+    /// A cut is not made where a piece would be thinner than its extent (at most the smallest
+    /// joint spacing) over this (default 30).
+    pub(super) max_aspect: Option<f64>,
+    #[serde(default)]
+    pub(super) joint_sets: Vec<Spanned<JointSetSpec>>,
+}
+
+/// A region of a rock mass's domain, in the shape syntax of `[[blocks]]`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RegionSpec {
+    pub(super) vertices: Option<Vec<Exact<3>>>,
+    #[serde(rename = "box")]
+    pub(super) box_: Option<BoxSpec>,
+    pub(super) dodecahedron: Option<DodecahedronSpec>,
+    pub(super) prism: Option<PrismSpec>,
+}
+
+impl RegionSpec {
+    pub(super) fn shape(&self) -> ShapeSpec<'_> {
+        ShapeSpec {
+            vertices: self.vertices.as_deref(),
+            box_: self.box_.as_ref(),
+            dodecahedron: self.dodecahedron.as_ref(),
+            prism: self.prism.as_ref(),
+        }
+    }
+}
+
+/// Which blocks of a rock mass are held: a block is fixed when its centroid meets any of these.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub(super) struct FixedSpec {
+    /// z below this, m.
+    pub(super) below: Option<f64>,
+    /// z above this, m.
+    pub(super) above: Option<f64>,
+    pub(super) x_below: Option<f64>,
+    pub(super) x_above: Option<f64>,
+    pub(super) y_below: Option<f64>,
+    pub(super) y_above: Option<f64>,
+    /// Every block of these regions (numbered from 1).
+    #[serde(default)]
+    pub(super) regions: Vec<u16>,
+}
+
+/// One `[[rock_masses.joint_sets]]` entry.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct JointSetSpec {
+    pub(super) name: String,
+    /// Degrees below horizontal.
+    pub(super) dip: f64,
+    /// Degrees clockwise from north (+y).
+    pub(super) dip_direction: f64,
+    /// m, normal distance between planes.
+    pub(super) spacing: f64,
+    #[serde(default, deserialize_with = "exact")]
+    pub(super) origin: [f64; 3],
+    pub(super) friction_angle: Option<f64>,
+    pub(super) cohesion: Option<f64>,
+    /// m: standard deviation of each spacing.
+    #[serde(default)]
+    pub(super) spacing_deviation: f64,
+    /// Degrees: standard deviation of each plane's tilt, in each of two directions.
+    #[serde(default)]
+    pub(super) orientation_deviation: f64,
+    #[serde(default)]
+    pub(super) seed: u64,
+}
+
+/// One top-level `[[joint_sets]]` entry: a set by its planes.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct PlanesSpec {
+    pub(super) name: String,
+    /// The rock mass whose blocks the planes cut.
+    pub(super) rock_mass: String,
+    pub(super) friction_angle: Option<f64>,
+    pub(super) cohesion: Option<f64>,
+    /// Each plane as [n_x, n_y, n_z, d]: the points x with n·x = d (n a unit normal).
+    pub(super) planes: Vec<Exact<4>>,
 }
 
 #[derive(Deserialize)]

@@ -27,6 +27,8 @@
 mod build;
 mod format;
 mod locate;
+mod rock_mass;
+mod write;
 
 use std::fmt;
 use std::io::Read;
@@ -36,9 +38,15 @@ use build::{build_block, check_material, check_overlaps};
 use format::SceneFile;
 use locate::{key_at, key_line, line_of};
 
-use crate::model::Model;
-use crate::params::SolverParams;
+pub use rock_mass::RockMassReport;
+pub use write::cut_scene;
+
+use crate::model::{Block, Model, RockMassOf};
+use crate::params::{JointSetParams, SolverParams};
+use crate::physics::geometry::convex_hull;
+use crate::physics::mechanics::Material;
 use crate::text::short;
+use rock_mass::CutBlock;
 
 /// The largest scene file read, in bytes (16 MiB). The largest generated wall (99 998 blocks)
 /// takes 12.8 MB. toml's parse keeps every number with its place in the text, so the memory of a
@@ -98,10 +106,19 @@ pub struct Scene {
     pub name: String,
     pub params: SolverParams,
     pub model: Model,
+    /// What cutting each `[[rock_masses]]` entry gave.
+    pub rock_masses: Vec<RockMassReport>,
 }
 
 /// Reads and validates a scene file.
 pub fn load(path: &Path) -> Result<Scene, SceneError> {
+    let (text, shown, default_name) = read_text(path)?;
+    parse(&text, &shown, &default_name)
+}
+
+/// A scene file's text, with the path as messages show it and the scene's default name (the
+/// file's stem).
+fn read_text(path: &Path) -> Result<(String, String, String), SceneError> {
     let shown = path.display().to_string();
     let err = |line: Option<usize>, message: String| SceneError {
         path: shown.clone(),
@@ -129,7 +146,7 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".into());
-    parse(&text, &shown, &default_name)
+    Ok((text, shown, default_name))
 }
 
 /// The file's bytes, at most [`MAX_FILE_BYTES`] of them. A regular file says its size up front;
@@ -193,6 +210,18 @@ fn first_key_line(text: &str, keys: &[&str]) -> Option<usize> {
 
 /// Parses scene text; `path` is used in messages only.
 pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneError> {
+    parse_cut(text, path, default_name).map(|(scene, _)| scene)
+}
+
+/// What the rock masses were cut into, as `dda3d cut` writes it out: the corners each of their
+/// blocks was built from (the blocks after the `[[blocks]]`, in order), and their sets.
+struct CutOutput {
+    points: Vec<Vec<crate::physics::geometry::Vec3>>,
+    sets: Vec<rock_mass::CutSet>,
+}
+
+/// [`parse`], with what the rock masses were cut into.
+fn parse_cut(text: &str, path: &str, default_name: &str) -> Result<(Scene, CutOutput), SceneError> {
     let err = |line: Option<usize>, message: String| SceneError {
         path: path.to_string(),
         line,
@@ -202,8 +231,8 @@ pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneE
         let (line, message) = toml_error(text, &e);
         err(line, message)
     })?;
-    let mut params = file.solver;
-    params.joint = file.joint;
+    let mut params = file.solver.clone();
+    params.joint = file.joint.clone();
     params
         .check()
         .map_err(|e| err(first_key_line(text, e.keys), e.message))?;
@@ -215,10 +244,10 @@ pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneE
             err(Some(line), e)
         })?;
     }
-    if file.blocks.is_empty() {
+    if file.blocks.is_empty() && file.rock_masses.is_empty() {
         return Err(err(
             None,
-            "no [[blocks]]: a scene needs at least one block".into(),
+            "no [[blocks]] and no [[rock_masses]]: a scene needs at least one block".into(),
         ));
     }
     if let Some(extra) = file.blocks.get(MAX_BLOCKS) {
@@ -230,27 +259,59 @@ pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneE
             ),
         ));
     }
-
-    let mut blocks = Vec::with_capacity(file.blocks.len());
-    let mut lines = Vec::with_capacity(file.blocks.len());
-    for (k, spanned) in file.blocks.iter().enumerate() {
-        let line = Some(line_of(text, spanned.span().start));
-        let spec = spanned.get_ref();
-        let name = spec.name.clone().unwrap_or_else(|| format!("block{k}"));
-        let berr = |m: String| err(line, format!("block '{name}': {m}"));
-        let material = file
-            .materials
-            .get(&spec.material)
-            .map(|m| *m.get_ref())
-            .ok_or_else(|| {
-                berr(format!(
-                    "material '{}' is not defined under [materials]",
-                    spec.material
-                ))
-            })?;
-        blocks.push(build_block(spec, name.clone(), material).map_err(berr)?);
-        lines.push(line);
+    let mut masses = MassNames::of(&file).map_err(|(at, m)| err(Some(line_of(text, at)), m))?;
+    let (mut blocks, mut lines) = hand_blocks(&file, &mut masses, text, path)?;
+    let mut sets = Vec::new();
+    for s in &file.joint_sets {
+        let line = Some(line_of(text, s.span().start));
+        let spec = s.get_ref();
+        let index = masses.find(&spec.rock_mass).ok_or_else(|| {
+            err(
+                line,
+                format!(
+                    "joint set '{}': no block is of rock mass '{}'",
+                    spec.name, spec.rock_mass
+                ),
+            )
+        })?;
+        sets.push(
+            rock_mass::planes_set(spec, index, &params.joint).map_err(|(_, m)| err(line, m))?,
+        );
     }
+    let mut reports = Vec::new();
+    let mut cut_points = Vec::new();
+    let first_cut_set = sets.len();
+    for (k, m) in file.rock_masses.iter().enumerate() {
+        let line = Some(line_of(text, m.span().start));
+        let spec = m.get_ref();
+        let merr = |msg: String| err(line, format!("rock mass '{}': {msg}", spec.name));
+        let material = material_of(&file, &spec.material).map_err(merr)?;
+        let room = MAX_BLOCKS - blocks.len();
+        let cut = rock_mass::cut_mass(spec, k as u16, &params.joint, room)
+            .map_err(|(_, msg)| merr(msg))?;
+        for b in cut.blocks {
+            let points = b.vertices.clone();
+            blocks.push(cut_block(b, material).map_err(merr)?);
+            cut_points.push(points);
+            lines.push(line);
+        }
+        sets.extend(cut.sets);
+        reports.push(cut.report);
+    }
+    for (index, set) in sets.iter().enumerate() {
+        for b in blocks.iter_mut() {
+            if b.rock_mass.is_some_and(|r| r.mass == set.rock_mass) {
+                rock_mass::tag_faces(b, set, index as u16);
+            }
+        }
+    }
+    params.joint_sets = sets
+        .iter()
+        .map(|s| JointSetParams {
+            name: s.name.clone(),
+            joint: s.joint.clone(),
+        })
+        .collect();
     // A set, not a scan of the blocks before each: 10⁵ blocks are 5·10⁹ comparisons.
     let mut names = std::collections::HashSet::with_capacity(blocks.len());
     for (k, b) in blocks.iter().enumerate() {
@@ -263,11 +324,120 @@ pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneE
     }
     check_overlaps(&blocks).map_err(|(k, m)| err(lines[k], m))?;
     let name = file.name.unwrap_or_else(|| default_name.to_string());
-    Ok(Scene {
+    let scene = Scene {
         name: name.clone(),
         params,
-        model: Model { name, blocks },
-    })
+        model: Model {
+            name,
+            blocks,
+            rock_masses: masses.names,
+        },
+        rock_masses: reports,
+    };
+    let cut = CutOutput {
+        points: cut_points,
+        sets: sets.split_off(first_cut_set),
+    };
+    Ok((scene, cut))
+}
+
+/// The rock masses' names, by the index blocks and joint sets carry: those of `[[rock_masses]]`,
+/// then those that blocks written by `dda3d cut` name.
+struct MassNames {
+    names: Vec<String>,
+}
+
+impl MassNames {
+    /// The `[[rock_masses]]`' names, each once; an error at the offset of a repeated one.
+    fn of(file: &SceneFile) -> Result<Self, (usize, String)> {
+        let mut names: Vec<String> = Vec::new();
+        for m in &file.rock_masses {
+            let name = &m.get_ref().name;
+            if names.contains(name) || name.is_empty() {
+                return Err((
+                    m.span().start,
+                    format!("rock mass name '{name}' is empty or used twice"),
+                ));
+            }
+            names.push(name.clone());
+        }
+        Ok(MassNames { names })
+    }
+
+    fn find(&self, name: &str) -> Option<u16> {
+        self.names.iter().position(|n| n == name).map(|k| k as u16)
+    }
+
+    /// The index of `name`, added if new.
+    fn index(&mut self, name: &str) -> u16 {
+        self.find(name).unwrap_or_else(|| {
+            self.names.push(name.to_owned());
+            (self.names.len() - 1) as u16
+        })
+    }
+}
+
+/// A material of the file by name.
+fn material_of(file: &SceneFile, name: &str) -> Result<Material, String> {
+    file.materials
+        .get(name)
+        .map(|m| *m.get_ref())
+        .ok_or_else(|| format!("material '{name}' is not defined under [materials]"))
+}
+
+/// The `[[blocks]]`, built, with their lines.
+fn hand_blocks(
+    file: &SceneFile,
+    masses: &mut MassNames,
+    text: &str,
+    path: &str,
+) -> Result<(Vec<Block>, Vec<Option<usize>>), SceneError> {
+    let mut blocks = Vec::with_capacity(file.blocks.len());
+    let mut lines = Vec::with_capacity(file.blocks.len());
+    for (k, spanned) in file.blocks.iter().enumerate() {
+        let line = Some(line_of(text, spanned.span().start));
+        let spec = spanned.get_ref();
+        let name = spec.name.clone().unwrap_or_else(|| format!("block{k}"));
+        let berr = |m: String| SceneError {
+            path: path.to_string(),
+            line,
+            message: format!("block '{name}': {m}"),
+        };
+        let material = material_of(file, &spec.material).map_err(berr)?;
+        let mut block = build_block(spec, name.clone(), material).map_err(berr)?;
+        if let Some(mass) = &spec.rock_mass {
+            let region = spec.region.unwrap_or(1);
+            if region == 0 {
+                return Err(berr("region is numbered from 1".into()));
+            }
+            block.rock_mass = Some(RockMassOf {
+                mass: masses.index(mass),
+                region: region - 1,
+            });
+        }
+        blocks.push(block);
+        lines.push(line);
+    }
+    Ok((blocks, lines))
+}
+
+/// A block cut from a rock mass, built from its corners.
+fn cut_block(b: CutBlock, material: Material) -> Result<Block, String> {
+    let (vertices, topo) =
+        convex_hull(&b.vertices).map_err(|e| format!("block '{}': {e}", b.name))?;
+    let zero = crate::physics::geometry::Vec3::zeros();
+    let mut block = Block::new(
+        b.name,
+        material,
+        b.fixed,
+        vertices,
+        topo,
+        zero,
+        zero,
+        Vec::new(),
+    );
+    block.rock_mass = Some(b.rock_mass);
+    Ok(block)
 }
 
 #[cfg(test)]

@@ -9,6 +9,7 @@ use super::counters::debug_log;
 use super::step_control::max_step_penetration;
 use crate::contact::detection::detect_pair;
 use crate::contact::groups::{Bounds, ContactGroups};
+use crate::contact::joint::joint_set;
 use crate::contact::kinematics::normal_kinematics;
 use crate::contact::record::ContactRecord;
 use crate::contact::{Candidate, ContactKey, ContactState, DetectionParams, Shape};
@@ -65,7 +66,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
             activate_one(inp, &by_vertex, cand, w0)
         })
         .collect();
-    if inp.step == 0 && p.joint.cohesion > 0.0 {
+    if inp.step == 0 && active.iter().any(|c| p.joint_of(c.joint).cohesion > 0.0) {
         assign_cohesion_areas(&mut active);
     }
     (active, groups)
@@ -117,6 +118,7 @@ fn activate_one(
     keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen, w0);
     let ta = displacement_matrix(&(cand.xa - bi.mp.centroid));
     Active {
+        joint: joint_set(&cand.key, bi, bj),
         kin,
         ta,
         young: bi.material.young_modulus.min(bj.material.young_modulus),

@@ -24,6 +24,8 @@ pub(crate) struct Active {
     pub pair: usize,
     /// The smaller Young's modulus of the two blocks: the cap γE of (P21b).
     pub young: f64,
+    /// The joint set the contact lies on (`None`: `[joint]`); see [`SolverParams::joint_of`].
+    pub joint: Option<u16>,
     /// Shi's w0 of the contact's group (`crate::contact::groups`), m: the length its
     /// thresholds and ALM tolerances scale with.
     pub w0: f64,
@@ -70,7 +72,8 @@ impl Active {
             close_penetration: cp.close_threshold * self.w0,
             open_tension: cp.initial_penalty * (cp.open_threshold * self.w0),
             slip_tolerance: cp.open_threshold * self.w0,
-            tan_phi: p.joint.friction_angle.to_radians().tan(),
+            tan_phi: self.tan_phi(p),
+            held: p.joints_held,
             eps2: cp.eps2,
         }
     }
@@ -167,8 +170,12 @@ impl Active {
         } else {
             self.rec.normal_force.max(0.0)
         };
-        let tan_phi = p.joint.friction_angle.to_radians().tan();
-        n_prev * tan_phi
+        n_prev * self.tan_phi(p)
+    }
+
+    /// tan φ of the contact's joint.
+    pub fn tan_phi(&self, p: &SolverParams) -> f64 {
+        p.joint_of(self.joint).friction_angle.to_radians().tan()
     }
 
     /// T_b at the contact's point of block j: the spring's reference point if locked.

@@ -33,7 +33,6 @@ pub(crate) fn commit_contacts(
     maps: &[StepMap],
     active: &[Active],
 ) -> (HashMap<ContactKey, ContactRecord>, Vec<ContactSnapshot>) {
-    let tan_phi = p.joint.friction_angle.to_radians().tan();
     let mut contacts = Vec::new();
     let mut records = HashMap::with_capacity(active.len());
     for c in active {
@@ -50,7 +49,7 @@ pub(crate) fn commit_contacts(
                     } else {
                         rec.normal_force.max(0.0)
                     };
-                    n_prev * tan_phi
+                    n_prev * c.tan_phi(p)
                 }
             };
         } else {
@@ -72,6 +71,7 @@ pub(crate) fn commit_contacts(
                 shear_force: rec.shear_force,
                 penetration: c.dn + rec.overlap,
                 penalty: rec.penalty,
+                joint: c.joint,
                 lambda: if p.method == Method::Alm {
                     rec.lambda
                 } else {

@@ -273,6 +273,7 @@ mod tests {
             penetration: 0.0,
             penalty: 1.0,
             lambda: 0.0,
+            joint: None,
         };
         let r2 = unbalanced_ratio(std::slice::from_ref(&b), 1.0, &g, &[c], |_| true).max();
         assert!((r2 * 11.0 - r).abs() < 1e-9 * r, "{r2} {r}");

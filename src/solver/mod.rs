@@ -218,19 +218,31 @@ impl Solver {
     /// at rest, from the settled state.
     fn equilibrium_step(&mut self) -> Result<&StepStats, SolverError> {
         let locked = self.stage.as_ref().map(|s| s.phase) == Some(equilibrium::Phase::Locked);
-        let (stage_mode, stage_friction) = if locked {
-            let phi = equilibrium::STAGE_FRICTION_ANGLE.max(self.params.joint.friction_angle);
-            (Mode::Static, phi)
-        } else {
-            (Mode::Dynamic, self.params.joint.friction_angle)
-        };
+        let stage_mode = if locked { Mode::Static } else { Mode::Dynamic };
         let mode = std::mem::replace(&mut self.params.mode, stage_mode);
-        let friction = std::mem::replace(&mut self.params.joint.friction_angle, stage_friction);
+        // Held, not only at a high friction: in a jointed rock mass a friction of 89° fed the
+        // ALM loop λ → friction → λ (tan 89° = 57) until λ overflowed (issue #14).
+        self.params.joints_held = locked;
+        // Every joint (`[joint]` and each set's) held at the stage's friction at least.
+        let frictions: Vec<f64> = self
+            .params
+            .joints_mut()
+            .map(|j| {
+                let phi = j.friction_angle;
+                if locked {
+                    j.friction_angle = equilibrium::STAGE_FRICTION_ANGLE.max(phi);
+                }
+                phi
+            })
+            .collect();
         let loads = self.point_loads_off();
         let result = self.advance(f64::INFINITY);
         self.restore_point_loads(loads);
         self.params.mode = mode;
-        self.params.joint.friction_angle = friction;
+        self.params.joints_held = false;
+        for (j, phi) in self.params.joints_mut().zip(frictions) {
+            j.friction_angle = phi;
+        }
         let (dt, settled) = result?;
         let stage = self.stage.as_mut().expect("the stage is under way");
         let ratio = equilibrium::unbalanced_ratio(
@@ -462,11 +474,19 @@ impl Solver {
                     centroid: b.mp.centroid.into(),
                     velocity: [b.velocity[0], b.velocity[1], b.velocity[2]],
                     displacement: (b.mp.centroid - b.initial_centroid).into(),
+                    rock_mass: b.rock_mass.map(|r| (r.mass, r.region)),
                 })
                 .collect(),
             contacts: self.contacts.clone(),
             stats: self.last.clone(),
             equilibrium: self.equilibrium(),
+            rock_masses: self.model.rock_masses.clone(),
+            joint_sets: self
+                .params
+                .joint_sets
+                .iter()
+                .map(|s| s.name.clone())
+                .collect(),
         }
     }
 

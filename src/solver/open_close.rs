@@ -93,7 +93,7 @@ fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
         shear,
         shear_stiffness: cp.shear_penalty(c.rec.penalty),
         cohesion: if c.rec.intact {
-            inp.params.joint.cohesion * c.rec.cohesion_area
+            inp.params.joint_of(c.joint).cohesion * c.rec.cohesion_area
         } else {
             0.0
         },

@@ -370,7 +370,10 @@ impl UiState {
         if self.scene.is_some() && self.scene_key.as_ref() == Some(&key) {
             return; // same snapshot, same look: a large model is not rebuilt every frame
         }
-        if self.display.coloring != Coloring::PerBlock {
+        if !matches!(
+            self.display.coloring,
+            Coloring::PerBlock | Coloring::RockMass
+        ) {
             // Grow-only colour range, so a colour means the same speed all run long.
             let m = snap
                 .blocks
@@ -379,7 +382,7 @@ impl UiState {
                 .map(|b| match self.display.coloring {
                     Coloring::Velocity => DVec3::from_array(b.velocity).length(),
                     Coloring::Displacement => DVec3::from_array(b.displacement).length(),
-                    Coloring::PerBlock => 0.0,
+                    Coloring::PerBlock | Coloring::RockMass => 0.0,
                 })
                 .filter(|v| v.is_finite())
                 .fold(0.0, f64::max);

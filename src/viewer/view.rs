@@ -228,6 +228,8 @@ mod tests {
             contacts: vec![],
             stats: StepStats::default(),
             equilibrium: None,
+            rock_masses: Vec::new(),
+            joint_sets: Vec::new(),
         }
     }
 

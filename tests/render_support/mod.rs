@@ -94,6 +94,7 @@ pub fn slope_block() -> BlockSnapshot {
         faces,
         velocity: [0.0; 3],
         displacement: [0.0; 3],
+        rock_mass: None,
     }
 }
 
@@ -126,6 +127,7 @@ pub fn box_block(s: f64) -> BlockSnapshot {
         faces,
         velocity: [0.0; 3],
         displacement: [0.0; 3],
+        rock_mass: None,
     }
 }
 
@@ -149,6 +151,7 @@ pub fn slope_snapshot(t: f64, step: u64, s: f64, state: ContactState) -> Snapsho
             penetration: 1e-5,
             penalty: 1e9,
             lambda: forces[k],
+            joint: None,
         })
         .collect();
     Snapshot {
@@ -159,6 +162,8 @@ pub fn slope_snapshot(t: f64, step: u64, s: f64, state: ContactState) -> Snapsho
         contacts,
         stats: StepStats::default(),
         equilibrium: None,
+        rock_masses: Vec::new(),
+        joint_sets: Vec::new(),
     }
 }
 

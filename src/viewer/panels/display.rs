@@ -19,11 +19,14 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState) {
                 Coloring::PerBlock => "block",
                 Coloring::Velocity => "speed |v|",
                 Coloring::Displacement => "displacement |u|",
+                Coloring::RockMass => "rock mass",
             })
             .show_ui(ui, |ui| {
                 ui.selectable_value(&mut d.coloring, Coloring::PerBlock, "block");
                 ui.selectable_value(&mut d.coloring, Coloring::Velocity, "speed |v|");
                 ui.selectable_value(&mut d.coloring, Coloring::Displacement, "displacement |u|");
+                ui.selectable_value(&mut d.coloring, Coloring::RockMass, "rock mass")
+                    .on_hover_text("A colour per rock mass, shaded per region and block");
             });
     });
     ui.horizontal(|ui| {

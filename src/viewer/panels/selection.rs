@@ -18,7 +18,13 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
         ui.label(RichText::new("Click a block in the view to see its state and contacts.").weak());
         return;
     };
-    block_facts(ui, i, &snap.blocks[i], state.scene_file.blocks.get(i));
+    block_facts(
+        ui,
+        i,
+        &snap.blocks[i],
+        state.scene_file.blocks.get(i),
+        &snap.rock_masses,
+    );
     let contacts: Vec<_> = snap
         .contacts
         .iter()
@@ -40,11 +46,11 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
         .max_height(220.0)
         .show(ui, |ui| {
             egui::Grid::new("sel_contacts_grid")
-                .num_columns(6)
+                .num_columns(7)
                 .striped(true)
                 .spacing([8.0, 2.0])
                 .show(ui, |ui| {
-                    for h in ["with", "type", "state", "N", "d_n", "p_n"] {
+                    for h in ["with", "type", "state", "joint", "N", "d_n", "p_n"] {
                         ui.label(RichText::new(h).small().strong());
                     }
                     ui.end_row();
@@ -57,7 +63,13 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
 }
 
 /// Name, mass, material, centroid, displacement and velocity of block `i`.
-fn block_facts(ui: &mut egui::Ui, i: usize, b: &BlockSnapshot, info: Option<&BlockInfo>) {
+fn block_facts(
+    ui: &mut egui::Ui,
+    i: usize,
+    b: &BlockSnapshot,
+    info: Option<&BlockInfo>,
+    rock_masses: &[String],
+) {
     egui::Grid::new("sel")
         .num_columns(2)
         .spacing([10.0, 3.0])
@@ -72,6 +84,17 @@ fn block_facts(ui: &mut egui::Ui, i: usize, b: &BlockSnapshot, info: Option<&Blo
                 .strong(),
             );
             ui.end_row();
+            if let Some((mass, region)) = b.rock_mass {
+                ui.label("Rock mass");
+                ui.label(format!(
+                    "{}, region {}",
+                    rock_masses
+                        .get(usize::from(mass))
+                        .map_or("?", String::as_str),
+                    region + 1
+                ));
+                ui.end_row();
+            }
             if let Some(info) = info {
                 ui.label("Mass");
                 ui.label(format!("{} kg", num(info.mass)));
@@ -139,6 +162,14 @@ fn contact_row(ui: &mut egui::Ui, snap: &Snapshot, i: usize, c: &ContactSnapshot
         ContactState::Open => ("open", color32(OPEN_SRGB)),
     };
     ui.label(RichText::new(st).small().color(col));
+    let joint = c
+        .joint
+        .and_then(|k| snap.joint_sets.get(usize::from(k)))
+        .map_or("[joint]", String::as_str);
+    ui.label(RichText::new(joint).small()).on_hover_text(
+        "The joint set whose plane the contact lies on (its friction and cohesion), or the \
+         scene's [joint]",
+    );
     ui.label(RichText::new(format_force(c.normal_force)).small())
         .on_hover_text(format!(
             "normal {} , shear {}, λ = {}",

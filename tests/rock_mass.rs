@@ -1,0 +1,209 @@
+//! Rock masses cut from joint sets (issue #14): the blocks a scene's `[[rock_masses]]` load to —
+//! counts, volumes, conforming joint faces, no overlap — and `dda3d cut`'s file loading to the
+//! same model.
+
+use dda3d::model::Model;
+use dda3d::scene;
+
+const ROCK: &str =
+    "[materials.rock]\ndensity = 2600.0\nyoung_modulus = 1.0e10\npoisson_ratio = 0.25\n";
+
+fn parse(text: &str) -> scene::Scene {
+    scene::parse(text, "mass.toml", "mass").unwrap_or_else(|e| panic!("{e}\n{text}"))
+}
+
+/// A joint set table.
+fn set(name: &str, dip: f64, dd: f64, spacing: f64, origin: [f64; 3], extra: &str) -> String {
+    format!(
+        "[[rock_masses.joint_sets]]\nname = \"{name}\"\ndip = {dip}\ndip_direction = {dd}\n\
+         spacing = {spacing}\norigin = [{}, {}, {}]\n{extra}\n",
+        origin[0], origin[1], origin[2]
+    )
+}
+
+/// Three orthogonal sets 1 m apart in a 10 m cube: exactly 1000 unit boxes, named in order of
+/// the sets' planes (x slabs, then y, then z, from the lowest).
+#[test]
+fn three_orthogonal_sets_cut_a_cube_into_unit_boxes() {
+    let text = format!(
+        "{ROCK}[[rock_masses]]\nname = \"cube\"\nmaterial = \"rock\"\n\
+         regions = [ {{ box = {{ size = [10, 10, 10], center = [5, 5, 5] }} }} ]\n{}{}{}",
+        set("x", 90.0, 90.0, 1.0, [0.0; 3], ""),
+        set("y", 90.0, 0.0, 1.0, [0.0; 3], ""),
+        set("z", 0.0, 0.0, 1.0, [0.0; 3], ""),
+    );
+    let s = parse(&text);
+    let blocks = &s.model.blocks;
+    assert_eq!(blocks.len(), 1000);
+    for b in blocks {
+        assert!(
+            (b.mp.volume - 1.0).abs() < 1e-12,
+            "{} {}",
+            b.name,
+            b.mp.volume
+        );
+        assert_eq!((b.vertices.len(), b.topo.faces.len()), (8, 6), "{}", b.name);
+    }
+    assert_eq!(blocks[0].name, "cube/1");
+    let c0 = blocks[0].mp.centroid;
+    assert!((c0 - nalgebra::Vector3::new(0.5, 0.5, 0.5)).norm() < 1e-12);
+    let last = blocks[999].mp.centroid;
+    assert!((last - nalgebra::Vector3::new(9.5, 9.5, 9.5)).norm() < 1e-12);
+    // Every interior face is a joint face of its set; the cube's own faces are not.
+    let tagged: usize = blocks
+        .iter()
+        .map(|b| b.face_joints.iter().flatten().count())
+        .sum();
+    assert_eq!(tagged, 6000 - 600);
+    let r = &s.rock_masses[0];
+    assert_eq!((r.blocks, r.dropped, r.planes), (1000, 0, 27));
+}
+
+/// A seeded family of oblique, varied joint sets in a prism region and a box region: the
+/// blocks' volumes sum to the domain's, every joint face has its partner on the other side of
+/// its plane with the same area, and random points lie in exactly one block.
+#[test]
+fn random_sets_cut_without_gaps_or_overlaps() {
+    let mut rng = 12345u64;
+    let mut next = move || {
+        rng = rng
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (rng >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for case in 0..12 {
+        let mut sets = String::new();
+        for k in 0..3 {
+            let extra = if case % 2 == 1 {
+                format!(
+                    "spacing_deviation = 0.3\norientation_deviation = 5.0\nseed = {}\n",
+                    case * 10 + k
+                )
+            } else {
+                String::new()
+            };
+            sets += &set(
+                &format!("S{k}"),
+                90.0 * next(),
+                360.0 * next(),
+                1.0 + 1.5 * next(),
+                [next(), next(), next()],
+                &extra,
+            );
+        }
+        let text = format!(
+            "{ROCK}[[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\nmin_volume = 0.0\n\
+             regions = [ {{ prism = {{ base = [[0, 0, 0], [8, 0, 0], [8, 0, 6], [3, 0, 6]], \
+             extrude = [0, 7, 0] }} }}, {{ box = {{ size = [8, 7, 2], center = [4, 3.5, -1] }} }} ]\n{sets}"
+        );
+        let s = parse(&text);
+        let domain = (8.0 + 5.0) / 2.0 * 6.0 * 7.0 + 8.0 * 7.0 * 2.0;
+        let total: f64 = s.model.blocks.iter().map(|b| b.mp.volume).sum();
+        let r = &s.rock_masses[0];
+        assert!(
+            (r.domain_volume - domain).abs() < 1e-12 * domain,
+            "case {case}: {r}"
+        );
+        assert!(
+            (total - domain).abs() < 1e-9 * domain,
+            "case {case}: blocks {total} of {domain}: {r}"
+        );
+        assert_joint_faces_pair_up(&s.model, case);
+        assert_points_in_one_block(&s.model, case, &mut next);
+    }
+}
+
+/// On every joint plane the faces on its two sides have the same total area.
+fn assert_joint_faces_pair_up(model: &Model, case: usize) {
+    use std::collections::HashMap;
+    let mut area: HashMap<(u16, u32), [f64; 2]> = HashMap::new();
+    for b in &model.blocks {
+        for (f, tag) in b.face_joints.iter().enumerate() {
+            let Some(tag) = tag else { continue };
+            let face = &b.topo.faces[f];
+            let n = dda3d::physics::geometry::newell_normal(&b.vertices, face);
+            // Newell's normal is twice the area; its sign says which side the block is on.
+            let side = area.entry((tag.set, tag.plane)).or_default();
+            side[usize::from(!positive(&n))] += n.norm() / 2.0;
+        }
+    }
+    for ((set, plane), [a, b]) in area {
+        assert!(
+            (a - b).abs() <= 1e-9 * a.max(b),
+            "case {case}: set {set} plane {plane}: areas {a} and {b}"
+        );
+    }
+}
+
+/// Which way a face's normal points, by the sign of its largest component: the faces on one
+/// plane have the same normal up to its sign, so this splits them by side.
+fn positive(n: &nalgebra::Vector3<f64>) -> bool {
+    let m = n.abs();
+    let k = if m.z >= m.x && m.z >= m.y {
+        2
+    } else if m.x >= m.y {
+        0
+    } else {
+        1
+    };
+    n[k] > 0.0
+}
+
+/// 2000 random points of the domain each lie inside exactly one block (1e-9 of the model's
+/// size from any face counts as inside).
+fn assert_points_in_one_block(model: &Model, case: usize, next: &mut impl FnMut() -> f64) {
+    let mut tested = 0;
+    while tested < 2000 {
+        let p = nalgebra::Vector3::new(8.0 * next(), 7.0 * next(), -2.0 + 8.0 * next());
+        // Inside the domain: the box (z < 0), or the prism behind its face x = z / 2.
+        if p.z >= 0.0 && p.x < p.z / 2.0 {
+            continue;
+        }
+        tested += 1;
+        let inside = model
+            .blocks
+            .iter()
+            .filter(|b| {
+                b.topo
+                    .faces
+                    .iter()
+                    .enumerate()
+                    .all(|(f, face)| b.face_normals[f].dot(&(p - b.vertices[face[0]])) <= 1e-8)
+            })
+            .count();
+        assert_eq!(inside, 1, "case {case}: point {p:?} in {inside} blocks");
+    }
+}
+
+/// `dda3d cut`'s file loads to the same blocks, bit for bit, with the same joint faces and
+/// fixed blocks, and the same joint sets.
+#[test]
+fn the_cut_file_loads_to_the_same_model() {
+    let dir = std::env::temp_dir().join(format!("dda3d-cut-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("slope.toml");
+    std::fs::copy(
+        concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/jointed_slope.toml"),
+        &path,
+    )
+    .unwrap();
+    let direct = scene::load(&path).unwrap();
+    let (text, reports) = scene::cut_scene(&path).unwrap();
+    assert_eq!(reports, direct.rock_masses);
+    let out = dir.join("slope_cut.toml");
+    std::fs::write(&out, &text).unwrap();
+    let cut = scene::load(&out).unwrap();
+    assert!(cut.rock_masses.is_empty());
+    assert_eq!(cut.model.rock_masses, direct.model.rock_masses);
+    assert_eq!(cut.params, direct.params);
+    assert_eq!(cut.model.blocks.len(), direct.model.blocks.len());
+    for (a, b) in cut.model.blocks.iter().zip(&direct.model.blocks) {
+        assert_eq!(a.name, b.name);
+        assert_eq!(a.fixed, b.fixed, "{}", a.name);
+        assert_eq!(a.vertices, b.vertices, "{}", a.name);
+        assert_eq!(a.topo, b.topo, "{}", a.name);
+        assert_eq!(a.face_joints, b.face_joints, "{}", a.name);
+        assert_eq!(a.rock_mass, b.rock_mass, "{}", a.name);
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
