@@ -207,3 +207,57 @@ fn the_cut_file_loads_to_the_same_model() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Bad rock masses are one-line errors at their line, found before any long work: a dip out of
+/// range, a spacing that would cut the domain into more blocks than a scene may have, a region
+/// that is not convex (a prism whose base has a reflex corner), overlapping regions.
+#[test]
+fn bad_rock_masses_are_one_line_errors() {
+    let mass = |regions: &str, sets: &str| {
+        format!(
+            "{ROCK}[[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\nregions = [ {regions} ]\n{sets}"
+        )
+    };
+    let cube = "{ box = { size = [4, 4, 4], center = [0, 0, 0] } }";
+    let good = set("S", 30.0, 90.0, 1.0, [0.0; 3], "");
+    for (text, want) in [
+        (
+            mass(cube, &set("S", 95.0, 90.0, 1.0, [0.0; 3], "")),
+            "dip must lie in [0, 90]",
+        ),
+        (
+            mass(cube, &set("S", 30.0, 360.0, 1.0, [0.0; 3], "")),
+            "dip_direction",
+        ),
+        (
+            mass(cube, &set("S", 30.0, 90.0, 1e-6, [0.0; 3], "")),
+            "increase the spacing",
+        ),
+        (
+            mass(cube, &set("S", 30.0, 90.0, 0.0, [0.0; 3], "")),
+            "spacing must be positive",
+        ),
+        (
+            mass(
+                "{ prism = { base = [[0, 0, 0], [4, 0, 0], [4, 0, 4], [2, 0, 1], [0, 0, 4]], extrude = [0, 4, 0] } }",
+                &good,
+            ),
+            "not convex",
+        ),
+        (
+            mass(
+                &format!("{cube}, {{ box = {{ size = [4, 4, 4], center = [1, 0, 0] }} }}"),
+                &good,
+            ),
+            "overlaps region 1",
+        ),
+    ] {
+        let start = std::time::Instant::now();
+        let e = scene::parse(&text, "mass.toml", "mass").expect_err(want);
+        let line = e.to_string();
+        assert!(line.contains(want), "{line}");
+        assert!(line.starts_with("mass.toml: line "), "{line}");
+        assert_eq!(line.lines().count(), 1);
+        assert!(start.elapsed().as_secs_f64() < 5.0, "{want}: slow");
+    }
+}

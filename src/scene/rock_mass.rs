@@ -249,10 +249,10 @@ fn regions(spec: &RockMassSpec) -> Result<Vec<Polyhedron>, (Option<String>, Stri
         let rerr = |m: String| (Some("regions".into()), format!("region {}: {m}", k + 1));
         let points = shape_points(&r.get_ref().shape()).map_err(rerr)?;
         let (vertices, topo) = convex_hull(&points).map_err(|e| rerr(e.to_string()))?;
-        if let Some(p) = inside_point(&points, &vertices, &topo.faces) {
+        if let Some(p) = off_hull_edges(&points, &vertices, &topo) {
             return Err(rerr(format!(
-                "not convex: its point {} ({}, {}, {}) lies inside the others' hull; give a \
-                 non-convex domain as several convex regions",
+                "not convex: its point {} ({}, {}, {}) is not on an edge of the points' convex \
+                 hull; give a non-convex domain as several convex regions",
                 p + 1,
                 short(points[p].x),
                 short(points[p].y),
@@ -279,24 +279,25 @@ fn regions(spec: &RockMassSpec) -> Result<Vec<Polyhedron>, (Option<String>, Stri
     Ok(out)
 }
 
-/// The first of `points` that lies inside the hull (`vertices`, `faces`) by more than the hull's
-/// tolerance, i.e. that a convex shape would not have.
-fn inside_point(points: &[Vec3], vertices: &[Vec3], faces: &[Vec<usize>]) -> Option<usize> {
+/// The first of `points` that lies on no edge of their hull (`vertices`, `topo`), beyond the
+/// hull's tolerance: a convex shape's points are its corners, or lie on its edges. A point
+/// inside the hull, or inside one of its faces (the reflex corner of a prism's base), is not.
+fn off_hull_edges(
+    points: &[Vec3],
+    vertices: &[Vec3],
+    topo: &crate::physics::geometry::Topology,
+) -> Option<usize> {
     let (lo, hi) = bounding_box(vertices);
     let tol = 1e-6 * (hi - lo).norm();
-    let planes: Vec<(Vec3, f64)> = faces
-        .iter()
-        .map(|f| {
-            let n = crate::physics::geometry::newell_normal(vertices, f).normalize();
-            (n, n.dot(&vertices[f[0]]))
-        })
-        .collect();
+    let to_segment = |p: &Vec3, a: &Vec3, b: &Vec3| {
+        let ab = b - a;
+        let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+        (p - (a + ab * t)).norm()
+    };
     points.iter().position(|p| {
-        let nearest = planes
+        topo.edges
             .iter()
-            .map(|(n, d)| d - n.dot(p))
-            .fold(f64::INFINITY, f64::min);
-        nearest > tol
+            .all(|e| to_segment(p, &vertices[e.v[0]], &vertices[e.v[1]]) > tol)
     })
 }
 
