@@ -284,6 +284,13 @@ impl UiState {
                 self.params.last_sent = f.params.clone();
                 self.speed = f.speed;
             }
+            // A scene with rock masses opens coloured by rock mass (the user may change it).
+            if self.frame.is_none()
+                && !f.snapshot.rock_masses.is_empty()
+                && self.display.coloring == Coloring::PerBlock
+            {
+                self.display.coloring = Coloring::RockMass;
+            }
             self.frame = Some(f);
         }
         let generation = self.history.generation;
