@@ -57,37 +57,45 @@ fn run_free_block(text: &str, duration: f64, free: impl Fn(&Vec3) -> bool) -> Mo
     }
 }
 
-/// One joint set (dip `dip`, dipping east, friction `phi`) through the middle of a 6 × 3 × 6 m
-/// box, and a vertical release joint R across it at x = 0; `[joint]` has friction `other`. The
-/// block above J and in front of R is the free one: its upper end lies inside the face below it
-/// (where the two pieces of one cut meet corner to corner, a corner of the block sliding onto
-/// the face below closed as a fresh locked contact and held the block for a step: see the issue
-/// note).
+/// One joint set J (dip `dip`, dipping east, friction `phi`) through the origin, and a vertical
+/// release joint R at x = 0, in a 3 m wide slab of rock whose top is 1 m above J and parallel to
+/// it; `[joint]` has friction `other`. The block above J and in front of R is the free one, a
+/// squat slab 1 m thick and 3 / cos δ long. (Under a top at a fixed height the block above J was
+/// thicker at its front than at its back: at 25° its back corners carried almost nothing, and it
+/// rocked onto them as it slid.)
 fn planar(dip: f64, phi: f64, other: f64) -> String {
+    let (t, top) = (dip.to_radians().tan(), 1.0 / dip.to_radians().cos());
     format!(
         "[joint]\nfriction_angle = {other}\n{ROCK}[[rock_masses]]\nname = \"m\"\n\
-         material = \"rock\"\nregions = [ {{ box = {{ size = [6, 3, 6], center = [0, 0, 0] }} }} ]\n\
+         material = \"rock\"\nregions = [ {{ prism = {{ base = [[-3, -1.5, -3], [3, -1.5, -3], \
+         [3, -1.5, {}], [-3, -1.5, {}]], extrude = [0, 3, 0] }} }} ]\n\
          [[rock_masses.joint_sets]]\nname = \"J\"\ndip = {dip}\ndip_direction = 90.0\n\
          spacing = 100.0\nfriction_angle = {phi}\n\
          [[rock_masses.joint_sets]]\nname = \"R\"\ndip = 90.0\ndip_direction = 90.0\n\
-         spacing = 100.0\n"
+         spacing = 100.0\n",
+        -3.0 * t + top,
+        3.0 * t + top
     )
 }
 
 /// The block above a joint plane takes the set's friction, not `[joint]`'s: with the set's
 /// friction below the dip it slides (where `[joint]` would hold it), above the dip it stands
 /// (where `[joint]` would let it slide). Where it slides, its acceleration down the dip is
-/// Coulomb's a = g (sin δ − cos δ tan φ) within 1 % for 30°/20° and 40°/30°; it starts one step
-/// or more late (it is held in its first step).
+/// Coulomb's a = g (sin δ − cos δ tan φ) within 1 %, for a family of dips from 20° to 50° and
+/// factors of safety from 0.4 to 0.9.
 ///
-/// Not yet right, and so not asserted (issue #14's note): at 25°/15° the block slides at 0.38 of
-/// that acceleration, and the Hoek–Bray wedge below jams after a few millimetres.
+/// Not yet right, and so not asserted (issue #14's note): the block starts late, by up to a few
+/// steps on the steeper joints (it is held in its first steps), and the Hoek–Bray wedge below
+/// jams after a few millimetres.
 #[test]
 fn a_block_on_a_joint_takes_its_sets_friction() {
-    for (dip, phi, exact) in [
-        (30.0f64, 20.0f64, true),
-        (40.0, 30.0, true),
-        (25.0, 15.0, false),
+    for (dip, phi) in [
+        (30.0f64, 20.0f64),
+        (40.0, 30.0),
+        (25.0, 15.0),
+        (20.0, 10.0),
+        (50.0, 35.0),
+        (35.0, 33.0),
     ] {
         let n = pole(dip, 90.0);
         let above = |c: &Vec3| n.dot(c) > 0.0 && c.x > 0.0;
@@ -102,13 +110,18 @@ fn a_block_on_a_joint_takes_its_sets_friction() {
             along > 0.1 * 0.5 * want.norm() * t * t,
             "dip {dip}, φ {phi}: travelled only {along} m"
         );
-        if exact {
-            assert!(
-                (m.acceleration - want).norm() < 0.01 * want.norm(),
-                "dip {dip}, φ {phi}: a = {:?}, closed form {want:?}",
-                m.acceleration
-            );
-        }
+        assert!(
+            (m.acceleration - want).norm() < 0.01 * want.norm(),
+            "dip {dip}, φ {phi}: a = {:?}, closed form {want:?}",
+            m.acceleration
+        );
+        // It starts late (printed, not asserted: issue #14's note): the travel falls short of
+        // the closed form's by what a late start of this many steps gives.
+        let travel = 0.5 * want.norm() * t * t;
+        eprintln!(
+            "dip {dip}, φ {phi}: travelled {along:.4} m of {travel:.4} m: a start {:.1} steps late",
+            (t - (2.0 * along / want.norm()).sqrt()) / 0.01
+        );
         // [joint] would let it slide: the set's friction holds it.
         let m = run_free_block(&planar(dip, dip + 5.0, 1.0), t, above);
         assert!(
