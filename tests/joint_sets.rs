@@ -4,6 +4,7 @@
 //! tetrahedral wedge cut by two sets slides along their line of intersection with
 //! a = g sin ψ (1 − F) when F < 1 and stands when F ≥ 1 (rock-mass reference §3).
 
+use dda3d::physics::geometry::{Mat3, box_vertices, convex_hull};
 use dda3d::rockmass::cut::{CutOptions, Plane, Polyhedron, cut};
 use dda3d::rockmass::orientation::{Vec3, pole};
 use dda3d::rockmass::wedge::{Sliding, admissible, wedge};
@@ -135,24 +136,13 @@ fn a_block_on_a_joint_takes_its_sets_friction() {
 /// A convex slope domain: the box [−4, 4] × [−3, 6] × [−3, h] behind the face plane through
 /// the origin (dip/dip direction `face`), as `vertices` for a region.
 fn slope_region(face: (f64, f64), h: f64) -> String {
-    let (x, y, z) = ([-4.0, 4.0], [-3.0, 6.0], [-3.0, h]);
-    let mut vertices = Vec::new();
-    for &a in &x {
-        for &b in &y {
-            for &c in &z {
-                vertices.push(Vec3::new(a, b, c));
-            }
-        }
-    }
-    let quads = [
-        [0, 1, 3, 2],
-        [4, 6, 7, 5],
-        [0, 4, 5, 1],
-        [2, 3, 7, 6],
-        [0, 2, 6, 4],
-        [1, 5, 7, 3],
-    ];
-    let faces = quads.iter().map(|q| q.to_vec()).collect();
+    let corners = box_vertices(
+        [8.0, 9.0, h + 3.0],
+        [0.0, 1.5, (h - 3.0) / 2.0],
+        &Mat3::identity(),
+    );
+    let (vertices, topo) = convex_hull(&corners).expect("a box");
+    let faces = topo.faces;
     let n = pole(face.0, face.1);
     let (pieces, _) = cut(
         &[Polyhedron { vertices, faces }],

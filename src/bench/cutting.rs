@@ -4,6 +4,7 @@
 
 use std::time::Instant;
 
+use crate::physics::geometry::{Mat3, box_vertices, convex_hull};
 use crate::rockmass::cut::{CutOptions, Plane, Polyhedron, cut};
 use crate::rockmass::orientation::{SetGeometry, Vec3, planes_through};
 use crate::scene;
@@ -39,24 +40,8 @@ pub fn cut_table(sizes: &[usize], repeat: usize) -> Result<(), String> {
 
 /// The cut alone: blocks made and the best time.
 fn time_cut(side: f64, sets: &[(f64, f64); 3], repeat: usize) -> Result<(usize, f64), String> {
-    let s = side;
-    let vertices: Vec<Vec3> = (0..8)
-        .map(|i| {
-            Vec3::new(
-                s * (i & 1) as f64,
-                s * ((i >> 1) & 1) as f64,
-                s * (i >> 2) as f64,
-            )
-        })
-        .collect();
-    let faces = vec![
-        vec![0, 2, 3, 1],
-        vec![4, 5, 7, 6],
-        vec![0, 1, 5, 4],
-        vec![1, 3, 7, 5],
-        vec![3, 2, 6, 7],
-        vec![2, 0, 4, 6],
-    ];
+    let corners = box_vertices([side; 3], [side / 2.0; 3], &Mat3::identity());
+    let (vertices, topo) = convex_hull(&corners).map_err(|e| e.to_string())?;
     let planes: Vec<Vec<Plane>> = sets
         .iter()
         .map(|&(dip, dip_direction)| {
@@ -69,18 +54,15 @@ fn time_cut(side: f64, sets: &[(f64, f64); 3], repeat: usize) -> Result<(usize, 
                 orientation_deviation: 0.0,
                 seed: 0,
             };
-            planes_through(&set, &vertices, 1e-9 * s, usize::MAX).map(|p| {
-                p.iter()
-                    .map(|p| Plane {
-                        normal: p.normal,
-                        offset: p.offset,
-                    })
-                    .collect()
-            })
+            planes_through(&set, &vertices, 1e-9 * side, usize::MAX)
+                .map(|p| p.iter().map(Plane::from).collect())
         })
         .collect::<Result<_, _>>()
         .map_err(|n| format!("{n} planes"))?;
-    let region = [Polyhedron { vertices, faces }];
+    let region = [Polyhedron {
+        vertices,
+        faces: topo.faces,
+    }];
     let opts = CutOptions {
         min_volume: 0.0,
         max_aspect: 30.0,

@@ -97,10 +97,17 @@ pub fn convex_hull(points: &[Vec3]) -> Result<(Vec<Vec3>, Topology), GeometryErr
     if n < 4 {
         return Err(GeometryError::TooFewVertices(n));
     }
-    let mut faces = hull::faces(&pts, tol, diag)?;
+    let faces = hull::faces(&pts, tol, diag)?;
+    corners_only(&pts, faces)
+}
 
-    // Keep only the points that are corners of some face, numbered in order of first
-    // appearance.
+/// The polyhedron of `faces` (rings of indices into `pts`): only the points that are corners of
+/// some face, numbered in order of first appearance, and the topology.
+pub(super) fn corners_only(
+    pts: &[Vec3],
+    mut faces: Vec<Vec<usize>>,
+) -> Result<(Vec<Vec3>, Topology), GeometryError> {
+    let n = pts.len();
     let mut used = vec![usize::MAX; n];
     let mut vertices = Vec::new();
     for f in &faces {
@@ -215,8 +222,8 @@ pub fn mass_properties(vertices: &[Vec3], faces: &[Vec<usize>]) -> MassPropertie
     }
 }
 
-/// Axis-aligned bounding box of a point set.
-pub fn bounding_box(points: &[Vec3]) -> (Vec3, Vec3) {
+/// Axis-aligned bounding box of a point set (lo > hi when there are no points).
+pub fn bounding_box<'a>(points: impl IntoIterator<Item = &'a Vec3>) -> (Vec3, Vec3) {
     let mut lo = Vec3::repeat(f64::INFINITY);
     let mut hi = Vec3::repeat(f64::NEG_INFINITY);
     for p in points {

@@ -83,10 +83,11 @@ mod tests;
 use std::cmp::Ordering;
 use std::fmt;
 
+use crate::physics::geometry::bounding_box;
 use sets::{Cutter, PlaneTree};
 use split::Block;
 
-pub type Vec3 = nalgebra::Vector3<f64>;
+pub use crate::physics::geometry::Vec3;
 
 /// ε = `SNAP_RELATIVE` × the bounding-box diagonal of all regions (the ε_g of the main reference
 /// §10): vertices closer than that to a plane are on it.
@@ -108,6 +109,16 @@ pub const NORMAL_TOLERANCE: f64 = 1e-6;
 pub struct Plane {
     pub normal: Vec3,
     pub offset: f64,
+}
+
+/// A joint set's plane as the cut takes it.
+impl From<&super::orientation::JointPlane> for Plane {
+    fn from(p: &super::orientation::JointPlane) -> Self {
+        Plane {
+            normal: p.normal,
+            offset: p.offset,
+        }
+    }
 }
 
 impl Plane {
@@ -238,7 +249,7 @@ pub fn cut(
 
 /// The snap tolerance ε of a call on `regions` (module doc).
 pub fn snap_tolerance(regions: &[Polyhedron]) -> f64 {
-    let (lo, hi) = input::bounds(regions.iter().flat_map(|r| r.vertices.iter()));
+    let (lo, hi) = bounding_box(regions.iter().flat_map(|r| r.vertices.iter()));
     if lo.x > hi.x {
         return 0.0;
     }
@@ -265,7 +276,7 @@ pub fn cut_all(
     input::check_options(opts)?;
     input::check_planes(sets)?;
     let eps = snap_tolerance(regions);
-    let (lo, hi) = input::bounds(regions.iter().flat_map(|r| r.vertices.iter()));
+    let (lo, hi) = bounding_box(regions.iter().flat_map(|r| r.vertices.iter()));
     let origin = if regions.is_empty() {
         Vec3::zeros()
     } else {

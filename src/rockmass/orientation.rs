@@ -2,12 +2,11 @@
 //! set, after `shared/docs/rock-mass-reference.md` §1. Axes: z up, north = +y, east = +x; angles
 //! in degrees, azimuths clockwise from north in [0°, 360°).
 
-use nalgebra::Vector3;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
-pub type Vec3 = Vector3<f64>;
+pub use crate::physics::geometry::Vec3;
 
 /// The horizontal unit vector of azimuth `az` (degrees clockwise from north = +y).
 fn horizontal(az_deg: f64) -> Vec3 {
@@ -364,15 +363,16 @@ impl Scatter {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use rand::Rng;
 
-    fn close(a: f64, b: f64, tol: f64) -> bool {
+    /// Shared with the wedge's tests.
+    pub(in crate::rockmass) fn close(a: f64, b: f64, tol: f64) -> bool {
         (a - b).abs() <= tol
     }
 
-    fn assert_vec(a: &Vec3, b: [f64; 3], tol: f64) {
+    pub(in crate::rockmass) fn assert_vec(a: &Vec3, b: [f64; 3], tol: f64) {
         assert!(
             (a - Vec3::from(b)).amax() <= tol,
             "{a:?} is not {b:?} within {tol}"

@@ -172,6 +172,7 @@ pub fn tetrahedron_volume(v: &[Vec3; 4]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::super::orientation::dip_and_direction;
+    use super::super::orientation::tests::{assert_vec, close};
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -181,17 +182,6 @@ mod tests {
     const A: (f64, f64) = (45.0, 105.0);
     const B: (f64, f64) = (70.0, 235.0);
     const FACE: (f64, f64) = (65.0, 185.0);
-
-    fn close(a: f64, b: f64, tol: f64) -> bool {
-        (a - b).abs() <= tol
-    }
-
-    fn assert_vec(a: &Vec3, b: [f64; 3], tol: f64) {
-        assert!(
-            (a - Vec3::from(b)).amax() <= tol,
-            "{a:?} is not {b:?} within {tol}"
-        );
-    }
 
     #[test]
     fn the_reference_wedge() {

@@ -96,24 +96,7 @@ pub(super) fn convex_hull_reference(
         }
     }
 
-    // Keep only the points that are corners of some face, and renumber.
-    let mut used = vec![usize::MAX; n];
-    let mut vertices = Vec::new();
-    for f in &faces {
-        for &m in f {
-            if used[m] == usize::MAX {
-                used[m] = vertices.len();
-                vertices.push(pts[m]);
-            }
-        }
-    }
-    for f in &mut faces {
-        for m in f.iter_mut() {
-            *m = used[*m];
-        }
-    }
-    let topo = Topology::from_faces(vertices.len(), faces)?;
-    Ok((vertices, topo))
+    super::super::geometry::corners_only(&pts, faces)
 }
 
 /// Andrew's monotone chain; returns the labels of the corners in counter-clockwise order.

@@ -1,18 +1,8 @@
 //! Checking the input of a cut, and turning a region into the first block.
 
 use super::split::{self, Block, Face};
-use super::{CutError, CutOptions, NORMAL_TOLERANCE, Plane, Polyhedron, REGION_TOLERANCE, Vec3};
-
-/// Lower and upper corners of the bounding box of `points` (lo > hi when there are none).
-pub(super) fn bounds<'a>(points: impl Iterator<Item = &'a Vec3>) -> (Vec3, Vec3) {
-    let mut lo = Vec3::repeat(f64::INFINITY);
-    let mut hi = Vec3::repeat(f64::NEG_INFINITY);
-    for p in points {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    (lo, hi)
-}
+use super::{CutError, CutOptions, NORMAL_TOLERANCE, Plane, Polyhedron, REGION_TOLERANCE};
+use crate::physics::geometry::bounding_box;
 
 pub(super) fn check_options(opts: &CutOptions) -> Result<(), CutError> {
     if !(opts.min_volume.is_finite() && opts.min_volume >= 0.0) {
@@ -74,7 +64,7 @@ pub(super) fn region_block(
             "not closed: an edge is not shared by exactly two faces in opposite directions",
         ));
     }
-    let (lo, hi) = bounds(region.faces.iter().flatten().map(|&i| &verts[i]));
+    let (lo, hi) = bounding_box(region.faces.iter().flatten().map(|&i| &verts[i]));
     let tol = REGION_TOLERANCE * (hi - lo).norm();
     let mut faces = Vec::with_capacity(region.faces.len());
     for ring in &region.faces {

@@ -4,6 +4,7 @@
 use std::cmp::Ordering;
 
 use super::{Plane, Vec3};
+use crate::physics::geometry::bounding_box;
 
 /// A face of a block being cut: its vertex ring (CCW from outside), its tag, and the plane it
 /// lies on (outward unit normal, n·x = offset). Caps copy the cutting plane exactly rather than
@@ -51,7 +52,7 @@ impl Block {
                 *v = map[*v];
             }
         }
-        let (lo, hi) = super::input::bounds(kept.iter());
+        let (lo, hi) = bounding_box(kept.iter());
         Self {
             region,
             verts: kept,

@@ -265,11 +265,11 @@ fn check_cover(
     points: usize,
 ) {
     let all = regions.iter().flat_map(|r| r.vertices.iter());
-    let (lo, hi) = super::super::input::bounds(all);
+    let (lo, hi) = crate::physics::geometry::bounding_box(all);
     let band = 1e-7 * (hi - lo).norm();
     let boxes: Vec<(Vec3, Vec3)> = pieces
         .iter()
-        .map(|p| super::super::input::bounds(p.vertices.iter()))
+        .map(|p| crate::physics::geometry::bounding_box(p.vertices.iter()))
         .collect();
     let mut found = 0;
     let mut tries = 0;
