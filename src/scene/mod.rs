@@ -210,7 +210,7 @@ fn first_key_line(text: &str, keys: &[&str]) -> Option<usize> {
 
 /// Parses scene text; `path` is used in messages only.
 pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneError> {
-    parse_cut(text, path, default_name).map(|(scene, _)| scene)
+    parse_cut(text, path, default_name, false).map(|(scene, _)| scene)
 }
 
 /// What the rock masses were cut into, as `dda3d cut` writes it out: the corners each of their
@@ -220,8 +220,14 @@ struct CutOutput {
     sets: Vec<rock_mass::CutSet>,
 }
 
-/// [`parse`], with what the rock masses were cut into.
-fn parse_cut(text: &str, path: &str, default_name: &str) -> Result<(Scene, CutOutput), SceneError> {
+/// [`parse`], with what the rock masses were cut into (their blocks' corners only with
+/// `keep_points`: a load that does not write them out does not copy them).
+fn parse_cut(
+    text: &str,
+    path: &str,
+    default_name: &str,
+    keep_points: bool,
+) -> Result<(Scene, CutOutput), SceneError> {
     let err = |line: Option<usize>, message: String| SceneError {
         path: path.to_string(),
         line,
@@ -274,9 +280,7 @@ fn parse_cut(text: &str, path: &str, default_name: &str) -> Result<(Scene, CutOu
                 ),
             )
         })?;
-        sets.push(
-            rock_mass::planes_set(spec, index, &params.joint).map_err(|(_, m)| err(line, m))?,
-        );
+        sets.push(rock_mass::planes_set(spec, index, &params.joint).map_err(|m| err(line, m))?);
     }
     let mut reports = Vec::new();
     let mut cut_points = Vec::new();
@@ -287,31 +291,18 @@ fn parse_cut(text: &str, path: &str, default_name: &str) -> Result<(Scene, CutOu
         let merr = |msg: String| err(line, format!("rock mass '{}': {msg}", spec.name));
         let material = material_of(&file, &spec.material).map_err(merr)?;
         let room = MAX_BLOCKS - blocks.len();
-        let cut = rock_mass::cut_mass(spec, k as u16, &params.joint, room)
-            .map_err(|(_, msg)| merr(msg))?;
+        let cut = rock_mass::cut_mass(spec, k as u16, &params.joint, room).map_err(merr)?;
         for b in cut.blocks {
-            let points = b.vertices.clone();
+            if keep_points {
+                cut_points.push(b.vertices.clone());
+            }
             blocks.push(cut_block(b, material).map_err(merr)?);
-            cut_points.push(points);
             lines.push(line);
         }
         sets.extend(cut.sets);
         reports.push(cut.report);
     }
-    for (index, set) in sets.iter().enumerate() {
-        for b in blocks.iter_mut() {
-            if b.rock_mass.is_some_and(|r| r.mass == set.rock_mass) {
-                rock_mass::tag_faces(b, set, index as u16);
-            }
-        }
-    }
-    params.joint_sets = sets
-        .iter()
-        .map(|s| JointSetParams {
-            name: s.name.clone(),
-            joint: s.joint.clone(),
-        })
-        .collect();
+    params.joint_sets = tag_joint_faces(&mut blocks, &sets);
     // A set, not a scan of the blocks before each: 10⁵ blocks are 5·10⁹ comparisons.
     let mut names = std::collections::HashSet::with_capacity(blocks.len());
     for (k, b) in blocks.iter().enumerate() {
@@ -375,6 +366,24 @@ impl MassNames {
             (self.names.len() - 1) as u16
         })
     }
+}
+
+/// Tags the faces of every rock mass's blocks that lie on the planes of its sets, and returns
+/// the sets' properties by the index the tags carry.
+fn tag_joint_faces(blocks: &mut [Block], sets: &[rock_mass::CutSet]) -> Vec<JointSetParams> {
+    for (index, set) in sets.iter().enumerate() {
+        for b in blocks.iter_mut() {
+            if b.rock_mass.is_some_and(|r| r.mass == set.rock_mass) {
+                rock_mass::tag_faces(b, set, index as u16);
+            }
+        }
+    }
+    sets.iter()
+        .map(|s| JointSetParams {
+            name: s.name.clone(),
+            joint: s.joint.clone(),
+        })
+        .collect()
 }
 
 /// A material of the file by name.

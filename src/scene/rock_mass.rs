@@ -30,9 +30,6 @@ pub const DEFAULT_MAX_ASPECT: f64 = 30.0;
 /// The default `min_volume`, as a fraction of the median block's volume (reference §2.3).
 pub const DEFAULT_MIN_VOLUME_FRACTION: f64 = 1e-3;
 
-/// Snap tolerance of the cut, relative to the domain's bounding diagonal (reference §2.2).
-const SNAP: f64 = 1e-9;
-
 /// A joint set ready to tag faces: its properties and planes, and the rock mass it cuts.
 pub(super) struct CutSet {
     pub(super) name: String,
@@ -104,63 +101,56 @@ pub(super) fn cut_mass(
     index: u16,
     default_joint: &JointParams,
     max_blocks: usize,
-) -> Result<CutMass, (Option<String>, String)> {
+) -> Result<CutMass, String> {
     let regions = regions(spec)?;
     let points: Vec<Vec3> = regions
         .iter()
         .flat_map(|r| r.vertices.iter().copied())
         .collect();
-    let (lo, hi) = bounding_box(&points);
-    let snap = SNAP * (hi - lo).norm();
+    // The cut's own ε: a plane that only touches the domain within it cuts nothing.
+    let snap = cut::snap_tolerance(&regions);
     let mut sets = Vec::with_capacity(spec.joint_sets.len());
     let mut names = std::collections::HashSet::new();
     for s in &spec.joint_sets {
         let set = s.get_ref();
         if !names.insert(set.name.as_str()) {
-            return Err((None, format!("joint set name '{}' is used twice", set.name)));
+            return Err(format!("joint set name '{}' is used twice", set.name));
         }
-        let joint = set_joint(set, default_joint)?;
+        let joint = joint_of(
+            &set.name,
+            set.friction_angle,
+            set.cohesion,
+            default_joint,
+            "joint_sets",
+        )?;
         let geometry = set_geometry(set)?;
         let planes = planes_through(&geometry, &points, snap, max_blocks).map_err(|n| {
-            (
-                Some("spacing".into()),
-                format!(
-                    "joint set '{}': more than {n} planes cross the domain, more than the limit \
+            format!(
+                "joint set '{}': more than {n} planes cross the domain, more than the limit \
                      of {max_blocks} blocks could hold: increase the spacing",
-                    set.name
-                ),
+                set.name
             )
         })?;
         sets.push(CutSet {
             name: set.name.clone(),
             rock_mass: index,
             joint,
-            planes: planes
-                .iter()
-                .map(|p| Plane {
-                    normal: p.normal,
-                    offset: p.offset,
-                })
-                .collect(),
+            planes: planes.iter().map(Plane::from).collect(),
         });
     }
     let planes: Vec<Vec<Plane>> = sets.iter().map(|s| s.planes.clone()).collect();
     let max_aspect = spec.max_aspect.unwrap_or(DEFAULT_MAX_ASPECT);
     if !(max_aspect.is_finite() && max_aspect >= 1.0) {
-        return Err((
-            Some("max_aspect".into()),
-            format!("max_aspect must be a number ≥ 1, got {}", short(max_aspect)),
+        return Err(format!(
+            "max_aspect must be a number ≥ 1, got {}",
+            short(max_aspect)
         ));
     }
     let min_volume = match spec.min_volume {
         Some(v) if !(v.is_finite() && v >= 0.0) => {
-            return Err((
-                Some("min_volume".into()),
-                format!("min_volume must be ≥ 0 m³, got {}", short(v)),
-            ));
+            return Err(format!("min_volume must be ≥ 0 m³, got {}", short(v)));
         }
-        Some(v) => Some(v),
-        None => None,
+        other => other,
     };
     let opts = CutOptions {
         min_volume: min_volume.unwrap_or(0.0),
@@ -172,8 +162,7 @@ pub(super) fn cut_mass(
             .fold(f64::INFINITY, f64::min),
         max_blocks,
     };
-    let (mut pieces, mut report) =
-        cut::cut(&regions, &planes, &opts).map_err(|e| (None, e.to_string()))?;
+    let (mut pieces, mut report) = cut::cut(&regions, &planes, &opts).map_err(|e| e.to_string())?;
     if min_volume.is_none() {
         drop_below_median_fraction(&mut pieces, &mut report);
     }
@@ -235,18 +224,15 @@ fn drop_below_median_fraction(pieces: &mut Vec<cut::Piece>, report: &mut cut::Cu
 
 /// The regions as convex polyhedra; each must be convex (every point it is given on its hull)
 /// and no two may overlap.
-fn regions(spec: &RockMassSpec) -> Result<Vec<Polyhedron>, (Option<String>, String)> {
+fn regions(spec: &RockMassSpec) -> Result<Vec<Polyhedron>, String> {
     if spec.regions.is_empty() {
-        return Err((
-            Some("regions".into()),
-            "regions is empty: give the domain as one or more convex shapes".into(),
-        ));
+        return Err("regions is empty: give the domain as one or more convex shapes".into());
     }
     let mut out: Vec<Polyhedron> = Vec::with_capacity(spec.regions.len());
     let mut hulls: Vec<(Vec<Vec3>, crate::physics::geometry::Topology)> =
         Vec::with_capacity(spec.regions.len());
     for (k, r) in spec.regions.iter().enumerate() {
-        let rerr = |m: String| (Some("regions".into()), format!("region {}: {m}", k + 1));
+        let rerr = |m: String| format!("region {}: {m}", k + 1);
         let points = shape_points(&r.get_ref().shape()).map_err(rerr)?;
         let (vertices, topo) = convex_hull(&points).map_err(|e| rerr(e.to_string()))?;
         if let Some(p) = off_hull_edges(&points, &vertices, &topo) {
@@ -314,29 +300,15 @@ fn is_fixed(fixed: &FixedSpec, c: &Vec3, region: usize) -> bool {
         || fixed.regions.iter().any(|&r| usize::from(r) == region + 1)
 }
 
-/// A set's joint: its own friction and cohesion where given, `[joint]`'s otherwise, in the
-/// ranges of `[joint]`'s keys.
-fn set_joint(
-    set: &JointSetSpec,
-    default: &JointParams,
-) -> Result<JointParams, (Option<String>, String)> {
-    joint_of(
-        &set.name,
-        set.friction_angle,
-        set.cohesion,
-        default,
-        "joint_sets",
-    )
-}
-
-/// The joint of a set named `name` from its optional friction and cohesion, checked.
+/// The joint of a set named `name` from its optional friction and cohesion (`[joint]`'s where
+/// not given), checked against the ranges of `[joint]`'s keys.
 fn joint_of(
     name: &str,
     friction_angle: Option<f64>,
     cohesion: Option<f64>,
     default: &JointParams,
     table: &str,
-) -> Result<JointParams, (Option<String>, String)> {
+) -> Result<JointParams, String> {
     let joint = JointParams {
         friction_angle: friction_angle.unwrap_or(default.friction_angle),
         cohesion: cohesion.unwrap_or(default.cohesion),
@@ -348,27 +320,19 @@ fn joint_of(
     for p in [&FRICTION_ANGLE, &COHESION] {
         p.check_finite(&params)
             .and_then(|()| p.check_range(&params))
-            .map_err(|m| {
-                (
-                    Some(p.name().into()),
-                    m.replacen(p.key, &format!("{table} '{name}': {}", p.name()), 1),
-                )
-            })?;
+            .map_err(|m| m.replacen(p.key, &format!("{table} '{name}': {}", p.name()), 1))?;
     }
     Ok(joint)
 }
 
 /// A set's geometry, checked: dip in [0, 90]°, dip direction in [0, 360)°, spacing > 0, the
 /// deviations ≥ 0 and the tilt at most [`MAX_ORIENTATION_DEVIATION`].
-fn set_geometry(set: &JointSetSpec) -> Result<SetGeometry, (Option<String>, String)> {
+fn set_geometry(set: &JointSetSpec) -> Result<SetGeometry, String> {
     let bad = |key: &str, want: &str, v: f64| {
-        Err((
-            Some(key.into()),
-            format!(
-                "joint set '{}': {key} must {want}, got {}",
-                set.name,
-                short(v)
-            ),
+        Err(format!(
+            "joint set '{}': {key} must {want}, got {}",
+            set.name,
+            short(v)
         ))
     };
     let checks: [(&str, f64, bool, &str); 5] = [
@@ -409,10 +373,7 @@ fn set_geometry(set: &JointSetSpec) -> Result<SetGeometry, (Option<String>, Stri
         }
     }
     if set.origin.iter().any(|x| !x.is_finite()) {
-        return Err((
-            Some("origin".into()),
-            format!("joint set '{}': origin is not finite", set.name),
-        ));
+        return Err(format!("joint set '{}': origin is not finite", set.name));
     }
     Ok(SetGeometry {
         dip: set.dip,
@@ -430,7 +391,7 @@ pub(super) fn planes_set(
     spec: &PlanesSpec,
     index: u16,
     default_joint: &JointParams,
-) -> Result<CutSet, (Option<String>, String)> {
+) -> Result<CutSet, String> {
     let joint = joint_of(
         &spec.name,
         spec.friction_angle,
@@ -445,13 +406,10 @@ pub(super) fn planes_set(
         if !(d.is_finite() && normal.iter().all(|c| c.is_finite()))
             || (normal.norm() - 1.0).abs() > 1e-9
         {
-            return Err((
-                Some("planes".into()),
-                format!(
-                    "joint set '{}': plane {} needs a unit normal and a finite offset",
-                    spec.name,
-                    k + 1
-                ),
+            return Err(format!(
+                "joint set '{}': plane {} needs a unit normal and a finite offset",
+                spec.name,
+                k + 1
             ));
         }
         planes.push(Plane { normal, offset: d });
