@@ -170,13 +170,15 @@ fn a_block_on_a_long_slab_is_measured_on_its_own_size() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// The energy watchdog: the rockfall with δ = 0.1, Δt_max = 0.05 s and no displacement check
-/// (`max_displacement_overshoot` = 1e9) takes steps so coarse that the ALM run creates energy
-/// (it "completed" before the watchdog). It must stop as diverged (exit 1) with one line saying
-/// which energy grew, keeping what it wrote, instead of reporting a completed run.
+/// The rockfall with δ = 0.1, Δt_max = 0.05 s and no displacement check
+/// (`max_displacement_overshoot` = 1e9) takes steps so coarse that the ALM run used to create
+/// energy: the watchdog stopped it as diverged. Since contacts close sliding where their blocks
+/// move past each other (issue #14), the coarse run no longer gains energy: its kinetic +
+/// gravitational + elastic energy never exceeds its start by 0.1 % of the rock's initial kinetic
+/// energy, and the run completes. (The watchdog's own rules are unit-tested in
+/// `solver::watchdog`; the diverged exit path in `tests/cli.rs`.)
 #[test]
-fn a_run_that_creates_energy_stops_as_diverged() {
-    let dir = tmp("energy");
+fn the_coarse_rockfall_creates_no_energy() {
     let text = std::fs::read_to_string(ROCKFALL)
         .unwrap()
         .replace(
@@ -184,29 +186,19 @@ fn a_run_that_creates_energy_stops_as_diverged() {
             "max_displacement_ratio = 0.1\nmax_displacement_overshoot = 1e9",
         )
         .replace("max_time_step = 0.01", "max_time_step = 0.05");
-    let scene = dir.join("coarse.toml");
-    std::fs::write(&scene, text).unwrap();
-    let out = dir.join("out");
-    let o = Command::new(env!("CARGO_BIN_EXE_dda3d"))
-        .arg("run")
-        .arg(&scene)
-        .args(["--quiet", "--out"])
-        .arg(&out)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("the energy grew by"), "{stderr}");
-    assert_eq!(stderr.trim().lines().count(), 1, "{stderr}");
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    assert_eq!(summary["status"], "diverged");
-    assert!(
-        std::fs::read_to_string(out.join("blocks.csv"))
-            .unwrap()
-            .lines()
-            .count()
-            > 100
-    );
-    std::fs::remove_dir_all(&dir).ok();
+    let s = dda3d::scene::parse(&text, "coarse.toml", "coarse").expect("parses");
+    let mut solver = dda3d::solver::Solver::new(s.model, s.params);
+    let energy = |st: &dda3d::snapshot::StepStats| {
+        st.kinetic_energy + st.potential_energy + st.elastic_energy
+    };
+    let first = solver.snapshot().stats;
+    let (start, kinetic) = (energy(&first), first.kinetic_energy);
+    assert!(kinetic > 1e5, "the rock moves: {kinetic} J");
+    let mut worst = f64::NEG_INFINITY;
+    while !solver.finished() {
+        solver.step().expect("the coarse run completes");
+        worst = worst.max(energy(&solver.snapshot().stats) - start);
+    }
+    println!("largest gain {worst:.3e} J of {kinetic:.3e} J kinetic at the start");
+    assert!(worst < 1e-3 * kinetic, "gained {worst:.3e} J");
 }

@@ -5,16 +5,15 @@
 //!
 //! The rules:
 //! - an open contact closes when it penetrates beyond a small threshold (hysteresis against
-//!   open–close chatter: the role of Shi's s0);
+//!   open–close chatter: the role of Shi's s0): locked, or sliding where its blocks move past
+//!   each other in the solve;
 //! - a closed contact opens under tension beyond p_n,1·f0·w0 (Shi's gap test f0·w0, as a force,
 //!   with the initial penalty so that a stiffened contact cannot hold tension);
 //! - a locked contact slides when its shear spring force exceeds N tan φ + c·A (Mohr–Coulomb;
 //!   cohesion only while the joint is intact), and only when the spring's shear displacement
 //!   exceeds f0·w0 (hysteresis for contacts that carry no load);
 //! - a sliding contact sticks again when its slip reverses, or stops (if it was sliding when the
-//!   step began), or when the friction held during the ALM loop stayed below its capacity
-//!   λ tan φ (see [`Observation::held_friction`]);
-//!   otherwise its friction follows the slip direction.
+//!   step began); otherwise its friction follows the slip direction.
 
 use super::ContactState;
 use crate::physics::geometry::Vec3;
@@ -34,9 +33,12 @@ pub struct LawParams {
     /// Joints held against sliding (the equilibrium stage's first phase): a locked contact
     /// stays locked whatever its shear; it can still open.
     pub held: bool,
-    /// ε2 of (P24): a held friction counts as below the capacity λ tan φ only by more than
-    /// this fraction (the multipliers themselves are converged to ε2).
-    pub eps2: f64,
+    /// A contact that closes while its blocks move past each other closes sliding (DDA-3a);
+    /// otherwise it closes locked, as in Shi's DDA (the DDA-3p baseline, whose friction, from
+    /// the previous solve's p_n d_n, is zero on a contact that has just closed: a 5 m block
+    /// bouncing on its soft penalty springs, re-closing sliding, gained energy until it
+    /// diverged).
+    pub close_sliding: bool,
 }
 
 /// What the last solve says of one contact.
@@ -61,9 +63,6 @@ pub struct Observation {
     pub lambda: f64,
     /// The contact was already sliding when the step began (not only since an earlier pass).
     pub slid_before: bool,
-    /// The multiplier at which a sliding contact's friction was held during the ALM loop,
-    /// because its slip reversed there (see the solver's ALM loop); `None` if it was not.
-    pub held_friction: Option<f64>,
 }
 
 /// The law's verdict on one contact.
@@ -73,6 +72,13 @@ pub enum Transition {
     Keep,
     /// An open contact closes, locked with a fresh shear spring.
     Close,
+    /// An open contact closes while its blocks slide past each other (its tangential motion in
+    /// the solve beyond the slip tolerance): it closes sliding along `tau`, with kinetic
+    /// friction, as Coulomb's law has it. Closed locked, it held its block for a pass while
+    /// every other contact of the block read as stopped (a wedge sliding on ten contacts stuck
+    /// each time one of its corners reached a neighbour's face); if friction can stop the
+    /// motion, the next pass sticks it.
+    CloseSliding { tau: Vec3 },
     /// A closed contact opens (and loses its cohesion).
     Open,
     /// A locked contact starts to slide along `tau` (and loses its cohesion).
@@ -87,10 +93,12 @@ pub enum Transition {
 pub fn classify(o: &Observation, p: &LawParams) -> Transition {
     match o.state {
         ContactState::Open => {
-            if o.penetration > p.close_penetration {
-                Transition::Close
-            } else {
+            if o.penetration <= p.close_penetration {
                 Transition::Keep
+            } else if let Some(tau) = closes_sliding(&o.slip, p) {
+                Transition::CloseSliding { tau }
+            } else {
+                Transition::Close
             }
         }
         _ if o.normal_force < -p.open_tension => Transition::Open,
@@ -107,19 +115,17 @@ pub fn classify(o: &Observation, p: &LawParams) -> Transition {
             }
         }
         ContactState::Slide => {
-            // The slip reversed, or stopped: the contact sticks again. So does a contact whose
-            // friction was held below its capacity λ tan φ: the slip reversed under a smaller
-            // friction and goes forward under the held one, so a friction within the capacity
-            // stops it.
-            let held_below = o
-                .held_friction
-                .is_some_and(|held| held < (1.0 - p.eps2) * o.lambda);
+            // The slip reversed, or stopped: the contact sticks again. (A contact whose friction
+            // the ALM loop held below its capacity λ tan φ, after its slip reversed in an early
+            // iteration, used to stick too; but λ is still converging then, and on a joint near
+            // its friction angle (35° at φ 33°) the corners stuck, slid and stuck again until
+            // they were settled locked: the block started 15 steps late.)
             // A stop counts only for a contact that was sliding when the step began. One that
             // began to slide in an earlier pass of this step is held still in this pass by its
             // neighbours' locked (stuck) contacts: sticking it then made the corners of a pushed
             // block take turns, lock against slide, and the block stood for two steps.
             let stopped = o.slid_before && o.slip.norm() < p.slip_tolerance;
-            if reversed(&o.slip, &o.tau, p.slip_tolerance) || stopped || held_below {
+            if reversed(&o.slip, &o.tau, p.slip_tolerance) || stopped {
                 Transition::Stick
             } else if o.slip.norm() > p.slip_tolerance {
                 // Friction follows the slip direction; it has not reversed here, so friction
@@ -132,6 +138,14 @@ pub fn classify(o: &Observation, p: &LawParams) -> Transition {
             }
         }
     }
+}
+
+/// The sliding direction of a contact that closes with the tangential motion `slip` (its slip in
+/// the solve, or the motion its blocks' velocities give over the step for a contact seen for
+/// the first time): `None` (it closes locked) below the slip tolerance, while joints are held,
+/// or without [`LawParams::close_sliding`].
+pub fn closes_sliding(slip: &Vec3, p: &LawParams) -> Option<Vec3> {
+    (p.close_sliding && slip.norm() > p.slip_tolerance && !p.held).then(|| slip.normalize())
 }
 
 /// True when `motion` goes back against the sliding direction `tau` by more than `tolerance`.
@@ -177,7 +191,7 @@ mod tests {
             slip_tolerance: 1e-6,
             tan_phi: 35f64.to_radians().tan(),
             held: false,
-            eps2: 0.01,
+            close_sliding: true,
         }
     }
 
@@ -192,7 +206,6 @@ mod tests {
             slip: Vec3::zeros(),
             tau: Vec3::x(),
             lambda: 1e4,
-            held_friction: None,
             slid_before: true,
         }
     }
@@ -332,18 +345,40 @@ mod tests {
         }
     }
 
+    /// An open contact that closes while its blocks move past each other closes sliding along
+    /// that motion, whatever the motion's direction; one that closes at rest closes locked; and
+    /// held joints (the equilibrium stage) and DDA-3p close locked.
     #[test]
-    fn a_sliding_contact_whose_friction_was_held_below_capacity_sticks() {
+    fn a_contact_closing_in_motion_closes_sliding() {
         let p = law();
-        let mut o = seen(ContactState::Slide);
+        let mut o = seen(ContactState::Open);
+        o.penetration = 2e-6;
+        for slip in [
+            Vec3::new(1e-3, 0.0, 0.0),
+            Vec3::new(0.0, -3e-6, 0.0),
+            Vec3::new(2e-6, 2e-6, 0.0),
+        ] {
+            o.slip = slip;
+            assert_eq!(
+                classify(&o, &p),
+                Transition::CloseSliding {
+                    tau: slip.normalize()
+                },
+                "slip {slip}"
+            );
+            let held = LawParams { held: true, ..p };
+            assert_eq!(classify(&o, &held), Transition::Close, "held, slip {slip}");
+            let shi = LawParams {
+                close_sliding: false,
+                ..p
+            };
+            assert_eq!(classify(&o, &shi), Transition::Close, "DDA-3p, slip {slip}");
+        }
+        o.slip = Vec3::new(0.5e-6, 0.0, 0.0);
+        assert_eq!(classify(&o, &p), Transition::Close, "below the tolerance");
+        o.penetration = 0.5e-6;
         o.slip = Vec3::new(1e-3, 0.0, 0.0);
-        o.held_friction = Some(0.995 * o.lambda);
-        assert!(
-            matches!(classify(&o, &p), Transition::Turn { .. }),
-            "within ε2"
-        );
-        o.held_friction = Some(0.9 * o.lambda);
-        assert_eq!(classify(&o, &p), Transition::Stick);
+        assert_eq!(classify(&o, &p), Transition::Keep, "not yet closed");
     }
 
     #[test]

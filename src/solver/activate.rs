@@ -11,6 +11,7 @@ use crate::contact::detection::detect_pair;
 use crate::contact::groups::{Bounds, ContactGroups};
 use crate::contact::joint::joint_set;
 use crate::contact::kinematics::normal_kinematics;
+use crate::contact::law;
 use crate::contact::record::ContactRecord;
 use crate::contact::{Candidate, ContactKey, ContactState, DetectionParams, Shape};
 use crate::model::Block;
@@ -31,6 +32,8 @@ pub(crate) struct ActivationInputs<'a> {
     /// The step about to be taken (0 for the first) and its start time.
     pub step: u64,
     pub time: f64,
+    /// The step about to be taken, s.
+    pub dt: f64,
 }
 
 /// This step's contacts, and the contact groups with their w0 and the block pairs near each
@@ -59,13 +62,14 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
             by_vertex.insert((k.i, k.j, k.feature_i), *k);
         }
     }
-    let mut active: Vec<Active> = cands
+    let (mut active, new): (Vec<Active>, Vec<bool>) = cands
         .into_iter()
         .map(|cand| {
             let w0 = groups.group_w0(cand.key.i as usize);
             activate_one(inp, &by_vertex, cand, w0)
         })
-        .collect();
+        .unzip();
+    slide_if_moving(&mut active, &new, inp);
     if inp.step == 0 && active.iter().any(|c| p.joint_of(c.joint).cohesion > 0.0) {
         assign_cohesion_areas(&mut active);
     }
@@ -78,7 +82,7 @@ fn activate_one(
     by_vertex: &HashMap<(u32, u32, u32), ContactKey>,
     cand: Candidate,
     w0: f64,
-) -> Active {
+) -> (Active, bool) {
     let p = inp.params;
     let blocks = inp.blocks;
     let (bi, bj) = (&blocks[cand.key.i as usize], &blocks[cand.key.j as usize]);
@@ -117,7 +121,7 @@ fn activate_one(
     let unseen = old.is_none_or(|r| r.state == ContactState::Open);
     keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen, w0);
     let ta = displacement_matrix(&(cand.xa - bi.mp.centroid));
-    Active {
+    let active = Active {
         joint: joint_set(&cand.key, bi, bj),
         kin,
         ta,
@@ -136,7 +140,8 @@ fn activate_one(
         changed: false,
         shear: Vec3::zeros(),
         slip: Vec3::zeros(),
-    }
+    };
+    (active, old.is_none())
 }
 
 /// The record of a contact seen for the first time: closed (locked) if it is touching or
@@ -192,6 +197,29 @@ fn keep_overlap(
         }
     }
     *d0 -= rec.overlap;
+}
+
+/// A contact first seen touching starts locked (Shi), unless its blocks move past each other:
+/// then it starts sliding along that motion (see [`law::closes_sliding`]), as one that closes
+/// in the open–close check does. Started locked, a vertex reaching the face of a block it slid
+/// along held its block for a pass while every other contact of the block read as stopped: a
+/// Hoek–Bray wedge sliding on ten contacts stuck each time one of its corners passed a
+/// neighbour's corner, and bounced back.
+fn slide_if_moving(active: &mut [Active], new: &[bool], inp: &ActivationInputs) {
+    for (c, &new) in active.iter_mut().zip(new) {
+        if !new || c.rec.state != ContactState::Lock {
+            continue;
+        }
+        let v = c.relative_velocity(inp.blocks);
+        let n = c.cand.normal;
+        let motion = (v - n * n.dot(&v)) * inp.dt;
+        if let Some(tau) = law::closes_sliding(&motion, &c.law(inp.params)) {
+            c.rec.state = ContactState::Slide;
+            c.rec.tau = tau;
+            c.rec.intact = false;
+            c.start = c.rec;
+        }
+    }
 }
 
 /// Shares each joint's contact area among its contact points (for cohesion, which acts only on

@@ -74,7 +74,7 @@ impl Active {
             slip_tolerance: cp.open_threshold * self.w0,
             tan_phi: self.tan_phi(p),
             held: p.joints_held,
-            eps2: cp.eps2,
+            close_sliding: p.method == Method::Alm,
         }
     }
 
@@ -149,6 +149,12 @@ impl Active {
                 reference: self.rec.reference,
             }),
         }
+    }
+
+    /// The velocity of block i at the contact point against block j's at its point, m/s.
+    pub fn relative_velocity(&self, blocks: &[Block]) -> Vec3 {
+        let (i, j) = self.blocks();
+        self.ta * blocks[i].velocity - self.tb_at(&self.cand.xb, blocks) * blocks[j].velocity
     }
 
     /// Δu_ab = T_a D_i − T_b D_j (reference §6.1) for the solution `d`.

@@ -244,6 +244,7 @@ mod tests {
             initial_boxes: &solver.initial_boxes,
             step: solver.step,
             time: solver.time,
+            dt: solver.dt,
         });
         let pairs = active
             .iter()

@@ -367,6 +367,7 @@ impl Solver {
             initial_boxes: &self.initial_boxes,
             step: self.step,
             time: self.time,
+            dt: self.dt,
         });
         self.w0 = groups.largest_w0();
         let pairs = assemble::sparsity_pattern(&active, &self.linear.pattern, &groups.pairs);

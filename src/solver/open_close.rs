@@ -47,8 +47,9 @@ pub(crate) fn check(
             c.rec.normal_force = c.force;
             continue;
         }
+        let (verdict, shear) = classify(inp, c, &du);
         let before = c.rec.state;
-        classify_and_apply(inp, c, &du);
+        apply(inp, c, verdict, shear);
         if c.rec.state == before {
             continue;
         }
@@ -71,14 +72,14 @@ pub(crate) fn check(
     changed
 }
 
-/// The contact law's verdict on one contact, applied to its record.
-fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
+/// The contact law's verdict on one contact, and the shear spring's extension N(Δ + Δu_ab) of
+/// a locked one.
+fn classify(inp: &CheckInputs, c: &mut Active, du: &Vec3) -> (Transition, Vec3) {
     let cp = &inp.params.contact;
     let closed = c.rec.state.is_closed();
     if closed {
         c.rec.normal_force = c.force;
     }
-    // The shear spring's extension N(Δ + Δu_ab) of a locked contact.
     let shear = if c.rec.state == ContactState::Lock {
         let n = c.cand.normal;
         let r = (c.cand.xa - c.rec.reference) + du;
@@ -100,28 +101,23 @@ fn classify_and_apply(inp: &CheckInputs, c: &mut Active, du: &Vec3) {
         slip: c.slip,
         tau: c.rec.tau,
         lambda: c.rec.lambda,
-        held_friction: c.friction_cap,
         slid_before: c.start.state == ContactState::Slide,
     };
-    let verdict = law::classify(&seen, &c.law(inp.params));
+    (law::classify(&seen, &c.law(inp.params)), shear)
+}
+
+/// Applies the law's verdict to the contact's record.
+fn apply(inp: &CheckInputs, c: &mut Active, verdict: Transition, shear: Vec3) {
     if c.rec.state == ContactState::Lock && verdict != Transition::Open {
         c.shear = shear;
     }
     match verdict {
         Transition::Keep => {}
-        Transition::Close => {
-            c.rec.state = ContactState::Lock;
-            c.rec.reference = c.cand.xb;
-            c.rec.lambda = 0.0;
-            // A new contact starts at p_n,1 (§6.1). One that was closed at the start of the
-            // step and only opened in an earlier pass is not new: it keeps its adapted penalty,
-            // which spares the (P21) rounds, and their factorizations, of raising it again.
-            c.rec.penalty = if c.start.state.is_closed() && inp.warm {
-                c.start.penalty
-            } else {
-                cp.initial_penalty
-            };
-            c.rec.normal_force = 0.0;
+        Transition::Close => close(inp, c),
+        Transition::CloseSliding { tau } => {
+            close(inp, c);
+            c.rec.state = ContactState::Slide;
+            c.rec.tau = tau;
         }
         Transition::Open => {
             c.rec.state = ContactState::Open;
@@ -158,6 +154,23 @@ pub(crate) fn settle_stragglers(
         counters.totals.frozen_contacts += 1;
     }
     Ok(())
+}
+
+/// Closes an open contact, locked with a fresh shear spring.
+fn close(inp: &CheckInputs, c: &mut Active) {
+    let cp = &inp.params.contact;
+    c.rec.state = ContactState::Lock;
+    c.rec.reference = c.cand.xb;
+    c.rec.lambda = 0.0;
+    // A new contact starts at p_n,1 (§6.1). One that was closed at the start of the
+    // step and only opened in an earlier pass is not new: it keeps its adapted penalty,
+    // which spares the (P21) rounds, and their factorizations, of raising it again.
+    c.rec.penalty = if c.start.state.is_closed() && inp.warm {
+        c.start.penalty
+    } else {
+        cp.initial_penalty
+    };
+    c.rec.normal_force = 0.0;
 }
 
 /// `DDA3D_DEBUG=1`: one line per state change.
