@@ -316,6 +316,29 @@ pub struct Summary {
     /// at its end, and whether R_max fell below the tolerance.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub equilibrium: Option<EquilibriumReport>,
+    /// What cutting each rock mass of the scene gave (absent without rock masses).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub rock_masses: Vec<RockMassSummary>,
+}
+
+/// One rock mass as cut at load time (what `dda3d cut` prints).
+#[derive(Clone, Debug, Serialize)]
+pub struct RockMassSummary {
+    pub name: String,
+    pub blocks: usize,
+    pub fixed: usize,
+    /// Joint planes that cut the domain.
+    pub planes: usize,
+    /// The regions' volume and the blocks', m³.
+    pub domain_volume: f64,
+    pub volume: f64,
+    /// The smallest block, m³.
+    pub smallest_block: f64,
+    /// Slivers dropped below `min_volume`, and their volume, m³.
+    pub dropped_slivers: usize,
+    pub dropped_volume: f64,
+    /// Cuts not made because a piece would have been a sliver (`max_aspect`).
+    pub cuts_not_made: usize,
 }
 
 impl Summary {
@@ -343,6 +366,7 @@ impl Summary {
             frozen_contacts: t.frozen_contacts,
             timings: t.timings.clone(),
             equilibrium: None,
+            rock_masses: Vec::new(),
         }
     }
 

@@ -261,3 +261,52 @@ fn bad_rock_masses_are_one_line_errors() {
         assert!(start.elapsed().as_secs_f64() < 5.0, "{want}: slow");
     }
 }
+
+/// `dda3d run` on a rock mass reports the cut in summary.json, as `dda3d cut` prints it: blocks,
+/// fixed blocks, planes, the blocks' volume against the domain's, and no slivers here; and
+/// contacts.csv names the set of each contact across a joint plane.
+#[test]
+fn a_run_reports_its_rock_masses() {
+    let dir = std::env::temp_dir().join(format!("dda3d-mass-run-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = format!(
+        "[solver]\nduration = 0.02\n{ROCK}[[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\n\
+         regions = [ {{ box = {{ size = [4, 4, 4], center = [0, 0, 2] }} }} ]\n\
+         fixed = {{ below = 1.5 }}\n{}{}",
+        set("H", 0.0, 0.0, 2.0, [0.0, 0.0, 0.0], ""),
+        set("V", 90.0, 90.0, 2.0, [0.0, 0.0, 0.0], "")
+    );
+    let scene = dir.join("mass.toml");
+    std::fs::write(&scene, text).unwrap();
+    let out = dir.join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        .args(["run", "--quiet", "--out"])
+        .arg(&out)
+        .arg(&scene)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let m = &summary["rock_masses"][0];
+    assert_eq!(m["name"], "m");
+    // The horizontal planes at z = 2 and the vertical one at x = 0 (those at z = 0, 4 and
+    // x = ±2 are the domain's faces): 4 blocks of 2 × 4 × 2 m, the lower two fixed.
+    assert_eq!(m["blocks"], 4, "{m}");
+    assert_eq!(m["fixed"], 2, "{m}");
+    assert_eq!(m["dropped_slivers"], 0);
+    let (v, dv) = (
+        m["volume"].as_f64().unwrap(),
+        m["domain_volume"].as_f64().unwrap(),
+    );
+    assert!((v - 64.0).abs() < 1e-9 && (dv - 64.0).abs() < 1e-9, "{m}");
+    assert!((m["smallest_block"].as_f64().unwrap() - 16.0).abs() < 1e-9);
+    let contacts = std::fs::read_to_string(out.join("contacts.csv")).unwrap();
+    let joints: std::collections::BTreeSet<&str> = contacts
+        .lines()
+        .skip(1)
+        .filter_map(|l| l.rsplit(',').next())
+        .collect();
+    assert!(joints.contains("H") && joints.contains("V"), "{joints:?}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -11,8 +11,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::exit::{self, Failure, Signal};
 use super::{CliError, SolverOverrides, load_scene};
-use crate::output::{OutputError, RunWriter, Summary, slug};
+use crate::output::{OutputError, RockMassSummary, RunWriter, Summary, slug};
 use crate::params::{Method, Mode};
+use crate::scene::RockMassReport;
 use crate::solver::{Solver, SolverError};
 use crate::text::short;
 
@@ -126,6 +127,23 @@ struct Record<'a> {
     mode: Mode,
     start: Instant,
     last_checkpoint: Instant,
+    rock_masses: Vec<RockMassSummary>,
+}
+
+/// summary.json's account of a rock mass.
+fn rock_mass_summary(r: &RockMassReport) -> RockMassSummary {
+    RockMassSummary {
+        name: r.name.clone(),
+        blocks: r.blocks,
+        fixed: r.fixed,
+        planes: r.planes,
+        domain_volume: r.domain_volume,
+        volume: r.volume,
+        smallest_block: r.smallest,
+        dropped_slivers: r.dropped,
+        dropped_volume: r.dropped_volume,
+        cuts_not_made: r.rejected_cuts,
+    }
 }
 
 impl Record<'_> {
@@ -136,6 +154,7 @@ impl Record<'_> {
         s.status = status.into();
         s.written_time = self.writer.written_time();
         s.equilibrium = solver.equilibrium();
+        s.rock_masses = self.rock_masses.clone();
         s
     }
 
@@ -215,6 +234,7 @@ pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
     let mut rec = Record {
         writer,
         scene: &name,
+        rock_masses: scene.rock_masses.iter().map(rock_mass_summary).collect(),
         method: scene.params.method,
         mode: scene.params.mode,
         start: Instant::now(),
