@@ -175,6 +175,8 @@ impl Default for JointParams {
 pub struct JointSetParams {
     /// The set's name, as `contacts.csv` writes it.
     pub name: String,
+    /// The rock mass it cuts (set names repeat across rock masses).
+    pub rock_mass: String,
     pub joint: JointParams,
 }
 

@@ -302,7 +302,7 @@ fn parse_cut(
         sets.extend(cut.sets);
         reports.push(cut.report);
     }
-    params.joint_sets = tag_joint_faces(&mut blocks, &sets);
+    params.joint_sets = tag_joint_faces(&mut blocks, &sets, &masses);
     // A set, not a scan of the blocks before each: 10⁵ blocks are 5·10⁹ comparisons.
     let mut names = std::collections::HashSet::with_capacity(blocks.len());
     for (k, b) in blocks.iter().enumerate() {
@@ -370,7 +370,11 @@ impl MassNames {
 
 /// Tags the faces of every rock mass's blocks that lie on the planes of its sets, and returns
 /// the sets' properties by the index the tags carry.
-fn tag_joint_faces(blocks: &mut [Block], sets: &[rock_mass::CutSet]) -> Vec<JointSetParams> {
+fn tag_joint_faces(
+    blocks: &mut [Block],
+    sets: &[rock_mass::CutSet],
+    masses: &MassNames,
+) -> Vec<JointSetParams> {
     for (index, set) in sets.iter().enumerate() {
         for b in blocks.iter_mut() {
             if b.rock_mass.is_some_and(|r| r.mass == set.rock_mass) {
@@ -381,6 +385,7 @@ fn tag_joint_faces(blocks: &mut [Block], sets: &[rock_mass::CutSet]) -> Vec<Join
     sets.iter()
         .map(|s| JointSetParams {
             name: s.name.clone(),
+            rock_mass: masses.names[usize::from(s.rock_mass)].clone(),
             joint: s.joint.clone(),
         })
         .collect()

@@ -6,7 +6,7 @@ use egui::RichText;
 
 use super::widgets::{length, num, param_label, param_slider, seconds};
 use crate::params::table::{self, Value};
-use crate::params::{Method, Mode, SolverParams};
+use crate::params::{JointParams, Method, Mode, SolverParams};
 use crate::physics::integrator::Scheme;
 use crate::viewer::state::UiState;
 
@@ -117,10 +117,29 @@ fn tolerance_rows(ui: &mut egui::Ui, e: &mut SolverParams, model: &Model) {
     ui.end_row();
 }
 
-/// Joint strength: φ and c (Mohr–Coulomb).
+/// Joint strength: φ and c (Mohr–Coulomb) of `[joint]`, then of each joint set of the scene's
+/// rock masses (their contacts take their set's, issue #14).
 fn joint_rows(ui: &mut egui::Ui, e: &mut SolverParams, model: &Model) {
-    let (j, young) = (&mut e.joint, model.young);
-    param_label(ui, &table::FRICTION_ANGLE);
+    let young = model.young;
+    strength_rows(ui, &mut e.joint, young, None);
+    for set in &mut e.joint_sets {
+        let name = format!("{}/{}", set.rock_mass, set.name);
+        strength_rows(ui, &mut set.joint, young, Some(&name));
+    }
+}
+
+/// The φ and c rows of one joint: `[joint]`'s (`set` None) or a joint set's.
+fn strength_rows(ui: &mut egui::Ui, j: &mut JointParams, young: f64, set: Option<&str>) {
+    let label = |ui: &mut egui::Ui, p: &table::Param| match set {
+        None => param_label(ui, p),
+        Some(name) => {
+            ui.label(format!("{name}: {}", p.label)).on_hover_text(format!(
+                "Joint set {name}: contacts between faces cut by one of its planes take this. {}",
+                p.doc()
+            ));
+        }
+    };
+    label(ui, &table::FRICTION_ANGLE);
     ui.add(param_slider(&mut j.friction_angle, &table::FRICTION_ANGLE, young).fixed_decimals(1));
     ui.label(
         RichText::new(format!(
@@ -131,7 +150,7 @@ fn joint_rows(ui: &mut egui::Ui, e: &mut SolverParams, model: &Model) {
     );
     ui.end_row();
 
-    param_label(ui, &table::COHESION);
+    label(ui, &table::COHESION);
     ui.add(param_slider(&mut j.cohesion, &table::COHESION, young).smallest_positive(1e2));
     ui.label("");
     ui.end_row();
