@@ -32,7 +32,7 @@ pub(crate) struct ActivationInputs<'a> {
     /// The step about to be taken (0 for the first) and its start time.
     pub step: u64,
     pub time: f64,
-    /// The step about to be taken, s.
+    /// Δt of the step about to be taken (before any cut), s.
     pub dt: f64,
 }
 

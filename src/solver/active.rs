@@ -121,6 +121,27 @@ impl Active {
                 fresh_spring: false,
             } => {}
         }
+        if self.rec.state.is_closed() && self.force < 0.0 {
+            self.release_tension(p);
+        }
+    }
+
+    /// A contact settled closed across a small gap (below the closing threshold) holds the
+    /// blocks together by p_n·d_n. At an adapted penalty of up to γE that was a glue: after
+    /// the equilibrium stage of a jointed slope, 118 settled contacts held up to 0.6 MN of
+    /// tension each, and blocks free to slide on their joint stood for seconds. Back at p_n,1,
+    /// the tension it can hold is at most p_n,1 · f_c · w0, the open test's threshold. The
+    /// shear spring keeps its force (its extension grows as its stiffness falls).
+    fn release_tension(&mut self, p: &SolverParams) {
+        let initial = p.contact.initial_penalty;
+        if self.rec.penalty <= initial {
+            return;
+        }
+        let stretch = p.contact.shear_penalty(self.rec.penalty) / p.contact.shear_penalty(initial);
+        let delta = self.cand.xa - self.rec.reference;
+        self.rec.reference = self.cand.xa - delta * stretch;
+        self.rec.penalty = initial;
+        self.rec.lambda = 0.0;
     }
 
     /// Locks a sliding contact with the friction it had: its new shear spring starts stretched
