@@ -159,7 +159,9 @@ pub fn reversed(motion: &Vec3, tau: &Vec3, tolerance: f64) -> bool {
 /// adapted penalty of up to γE it pulled a 12 mm gap shut within one step and gave a 40-block
 /// wall 0.1 MJ. Locked rather than sliding because a spring stores energy and gives it back,
 /// whereas sliding friction along a guessed direction can push the slip it should resist
-/// (settling as sliding fed a 100-block wall energy).
+/// (settling as sliding fed a 100-block wall energy). The exception is the solver's: a contact
+/// whose last verdict was [`Transition::Slide`] (its spring beyond its strength, so the
+/// direction is its shear's, not a guess) stays sliding.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Settled {
     Open,
