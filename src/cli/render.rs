@@ -46,8 +46,11 @@ pub struct RenderArgs {
     #[arg(long)]
     pub force_scale: Option<f64>,
     /// Draw contact normals as well as the force arrows.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "no_arrows")]
     pub normals: bool,
+    /// Draw no contact arrows: the blocks alone (a rock mass of thousands of contacts).
+    #[arg(long)]
+    pub no_arrows: bool,
     /// Transparent background.
     #[arg(long)]
     pub transparent: bool,
@@ -204,6 +207,9 @@ fn capture_options(args: &RenderArgs, out: &Path) -> Result<CaptureOptions, CliE
     if args.normals {
         opts.style.arrows = ArrowMode::Both;
     }
+    if args.no_arrows {
+        opts.style.arrows = ArrowMode::None;
+    }
     opts.style.transparent = args.transparent;
     if args.follow {
         opts.framing = Framing::EachFrame;
@@ -290,4 +296,37 @@ fn write_summary(
     let text = serde_json::to_string_pretty(&summary).unwrap_or_default();
     write_atomically(&path, text.as_bytes())
         .map_err(|e| Failure::Io(format!("{}: cannot write: {e}", path.display())))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cli::{Cli, CliCommand};
+    use clap::Parser;
+
+    fn options(extra: &[&str]) -> Result<CaptureOptions, String> {
+        let mut argv = vec!["dda3d", "render", "scene.toml"];
+        argv.extend_from_slice(extra);
+        let cli = Cli::try_parse_from(argv).map_err(|e| e.to_string())?;
+        let CliCommand::Render(args) = cli.command else {
+            panic!("a render command");
+        };
+        capture_options(&args, Path::new("out")).map_err(|e| format!("{e:?}"))
+    }
+
+    /// Force arrows by default; `--normals` adds the normals; `--no-arrows` draws the blocks
+    /// alone, and cannot be asked for with `--normals`.
+    #[test]
+    fn arrows_follow_the_flags() {
+        assert_eq!(options(&[]).unwrap().style.arrows, ArrowMode::Forces);
+        assert_eq!(
+            options(&["--normals"]).unwrap().style.arrows,
+            ArrowMode::Both
+        );
+        assert_eq!(
+            options(&["--no-arrows"]).unwrap().style.arrows,
+            ArrowMode::None
+        );
+        assert!(options(&["--normals", "--no-arrows"]).is_err());
+    }
 }

@@ -130,7 +130,8 @@ impl Active {
     /// blocks together by p_n·d_n. At an adapted penalty of up to γE that was a glue: after
     /// the equilibrium stage of a jointed slope, 118 settled contacts held up to 0.6 MN of
     /// tension each, and blocks free to slide on their joint stood for seconds. Back at p_n,1,
-    /// the tension it can hold is at most p_n,1 · f_c · w0, the open test's threshold. The
+    /// the tension it can hold is at most p_n,1 · `close_threshold` · w0 (its gap is below the
+    /// closing threshold), the size of the open test's threshold. The
     /// shear spring keeps its force (its extension grows as its stiffness falls).
     fn release_tension(&mut self, p: &SolverParams) {
         let initial = p.contact.initial_penalty;
