@@ -7,7 +7,7 @@ use crate::contact::law::{self, LawParams, Settled};
 use crate::contact::record::ContactRecord;
 use crate::contact::{Candidate, ContactState};
 use crate::model::Block;
-use crate::params::{Method, SolverParams};
+use crate::params::{ContactParams, Method, SolverParams};
 use crate::physics::geometry::Vec3;
 use crate::physics::mechanics::{Mat3x12, Vec12, displacement_matrix};
 
@@ -131,18 +131,22 @@ impl Active {
     /// the equilibrium stage of a jointed slope, 118 settled contacts held up to 0.6 MN of
     /// tension each, and blocks free to slide on their joint stood for seconds. Back at p_n,1,
     /// the tension it can hold is at most p_n,1 · `close_threshold` · w0 (its gap is below the
-    /// closing threshold), the size of the open test's threshold. The
-    /// shear spring keeps its force (its extension grows as its stiffness falls).
+    /// closing threshold), the size of the open test's threshold.
     fn release_tension(&mut self, p: &SolverParams) {
-        let initial = p.contact.initial_penalty;
-        if self.rec.penalty <= initial {
-            return;
+        if self.rec.penalty > p.contact.initial_penalty {
+            self.set_penalty(p.contact.initial_penalty, &p.contact);
+            self.rec.lambda = 0.0;
         }
-        let stretch = p.contact.shear_penalty(self.rec.penalty) / p.contact.shear_penalty(initial);
+    }
+
+    /// Sets p_n, keeping the shear spring's force: its stiffness p_τ is proportional to p_n, so
+    /// its extension is scaled by the inverse ratio (shortened as (P21) raises p_n, stretched as
+    /// [`Active::release_tension`] lowers it), and no energy is created.
+    pub fn set_penalty(&mut self, penalty: f64, cp: &ContactParams) {
+        let ratio = cp.shear_penalty(self.rec.penalty) / cp.shear_penalty(penalty);
         let delta = self.cand.xa - self.rec.reference;
-        self.rec.reference = self.cand.xa - delta * stretch;
-        self.rec.penalty = initial;
-        self.rec.lambda = 0.0;
+        self.rec.reference = self.cand.xa - delta * ratio;
+        self.rec.penalty = penalty;
     }
 
     /// Locks a sliding contact with the friction it had: its new shear spring starts stretched

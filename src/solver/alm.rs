@@ -192,12 +192,7 @@ fn update_multipliers(
         {
             let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
             if capped > c.rec.penalty {
-                // Keep the shear spring's force as its stiffness (p_τ ∝ p_n) grows: shorten
-                // the spring instead, so that no energy is created.
-                let shrink = cp.shear_penalty(c.rec.penalty) / cp.shear_penalty(capped);
-                let delta = c.cand.xa - c.rec.reference;
-                c.rec.reference = c.cand.xa - delta * shrink;
-                c.rec.penalty = capped;
+                c.set_penalty(capped, cp);
                 raised = true;
             }
         }
