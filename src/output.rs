@@ -14,6 +14,7 @@ use std::path::{Path, PathBuf};
 
 use serde::Serialize;
 
+use crate::rockmass::report::RockMassReport;
 use crate::snapshot::Snapshot;
 use crate::snapshot::{EquilibriumReport, RunTotals, Timings};
 
@@ -318,27 +319,7 @@ pub struct Summary {
     pub equilibrium: Option<EquilibriumReport>,
     /// What cutting each rock mass of the scene gave (absent without rock masses).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub rock_masses: Vec<RockMassSummary>,
-}
-
-/// One rock mass as cut at load time (what `dda3d cut` prints).
-#[derive(Clone, Debug, Serialize)]
-pub struct RockMassSummary {
-    pub name: String,
-    pub blocks: usize,
-    pub fixed: usize,
-    /// Joint planes that cut the domain.
-    pub planes: usize,
-    /// The regions' volume and the blocks', m³.
-    pub domain_volume: f64,
-    pub volume: f64,
-    /// The smallest block, m³.
-    pub smallest_block: f64,
-    /// Slivers dropped below `min_volume`, and their volume, m³.
-    pub dropped_slivers: usize,
-    pub dropped_volume: f64,
-    /// Cuts not made because a piece would have been a sliver (`max_aspect`).
-    pub cuts_not_made: usize,
+    pub rock_masses: Vec<RockMassReport>,
 }
 
 impl Summary {

@@ -11,9 +11,9 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::exit::{self, Failure, Signal};
 use super::{CliError, SolverOverrides, load_scene};
-use crate::output::{OutputError, RockMassSummary, RunWriter, Summary, slug};
+use crate::output::{OutputError, RunWriter, Summary, slug};
 use crate::params::{Method, Mode};
-use crate::scene::RockMassReport;
+use crate::rockmass::report::RockMassReport;
 use crate::solver::{Solver, SolverError};
 use crate::text::short;
 
@@ -127,23 +127,7 @@ struct Record<'a> {
     mode: Mode,
     start: Instant,
     last_checkpoint: Instant,
-    rock_masses: Vec<RockMassSummary>,
-}
-
-/// summary.json's account of a rock mass.
-fn rock_mass_summary(r: &RockMassReport) -> RockMassSummary {
-    RockMassSummary {
-        name: r.name.clone(),
-        blocks: r.blocks,
-        fixed: r.fixed,
-        planes: r.planes,
-        domain_volume: r.domain_volume,
-        volume: r.volume,
-        smallest_block: r.smallest,
-        dropped_slivers: r.dropped,
-        dropped_volume: r.dropped_volume,
-        cuts_not_made: r.rejected_cuts,
-    }
+    rock_masses: Vec<RockMassReport>,
 }
 
 impl Record<'_> {
@@ -234,7 +218,7 @@ pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
     let mut rec = Record {
         writer,
         scene: &name,
-        rock_masses: scene.rock_masses.iter().map(rock_mass_summary).collect(),
+        rock_masses: scene.rock_masses.clone(),
         method: scene.params.method,
         mode: scene.params.mode,
         start: Instant::now(),

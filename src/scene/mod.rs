@@ -38,7 +38,7 @@ use build::{build_block, check_material, check_overlaps};
 use format::SceneFile;
 use locate::{key_at, key_line, line_of};
 
-pub use rock_mass::RockMassReport;
+pub use crate::rockmass::report::RockMassReport;
 pub use write::cut_scene;
 
 use crate::model::{Block, Model, RockMassOf};

@@ -17,6 +17,7 @@ use crate::params::table::{COHESION, FRICTION_ANGLE};
 use crate::physics::geometry::{Vec3, bounding_box, convex_hull, overlap_depth};
 use crate::rockmass::cut::{self, CutOptions, Plane, Polyhedron};
 use crate::rockmass::orientation::{SetGeometry, planes_through};
+use crate::rockmass::report::RockMassReport;
 use crate::text::short;
 
 /// The largest tilt of a joint set's planes (`orientation_deviation`), degrees: beyond it the
@@ -44,47 +45,6 @@ pub(super) struct CutBlock {
     pub(super) fixed: bool,
     pub(super) vertices: Vec<Vec3>,
     pub(super) rock_mass: RockMassOf,
-}
-
-/// What cutting one rock mass gave, for `dda3d cut` and the run's log.
-#[derive(Clone, Debug, PartialEq)]
-pub struct RockMassReport {
-    pub name: String,
-    pub blocks: usize,
-    pub fixed: usize,
-    /// The joint planes that cut the domain.
-    pub planes: usize,
-    /// The regions' volume and the blocks', m³.
-    pub domain_volume: f64,
-    pub volume: f64,
-    pub smallest: f64,
-    /// Blocks dropped below `min_volume`, and their volume.
-    pub dropped: usize,
-    pub dropped_volume: f64,
-    /// Cuts not made because a piece would have been a sliver (`max_aspect`).
-    pub rejected_cuts: usize,
-}
-
-impl std::fmt::Display for RockMassReport {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(
-            f,
-            "rock mass '{}': {} blocks ({} fixed) from {} joint planes; volume {} m³ of the \
-             domain's {} m³ (relative difference {:.1e}); smallest block {} m³; {} slivers \
-             dropped ({} m³); {} cuts not made (slivers)",
-            self.name,
-            self.blocks,
-            self.fixed,
-            self.planes,
-            short(self.volume),
-            short(self.domain_volume),
-            (self.volume + self.dropped_volume - self.domain_volume).abs() / self.domain_volume,
-            short(self.smallest),
-            self.dropped,
-            short(self.dropped_volume),
-            self.rejected_cuts
-        )
-    }
 }
 
 /// A rock mass cut: its blocks and sets.
