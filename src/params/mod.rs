@@ -273,11 +273,6 @@ impl SolverParams {
             .map_or(&self.joint, |s| &s.joint)
     }
 
-    /// Every joint in the scene: `[joint]` and each joint set's.
-    pub fn joints_mut(&mut self) -> impl Iterator<Item = &mut JointParams> {
-        std::iter::once(&mut self.joint).chain(self.joint_sets.iter_mut().map(|s| &mut s.joint))
-    }
-
     /// Checks every value against the range of its [`table`] entry, then the number of steps the
     /// run would take ([`table::MAX_STEPS`]); returns a message naming the offending key. Every
     /// number is first checked to be finite, then each against its range, both in the table's

@@ -36,10 +36,6 @@ use crate::physics::integrator::Kinematics;
 use crate::physics::mechanics::Vec12;
 use crate::snapshot::{ContactSnapshot, EquilibriumReport};
 
-/// The friction angle of the joints during the stage, degrees: high enough that no contact
-/// slides (tan φ = 57).
-pub(crate) const STAGE_FRICTION_ANGLE: f64 = 89.0;
-
 /// A stage whose best R_max has not fallen below `PLATEAU_GAIN` of itself for
 /// this many steps is a mechanism (R stays at a/g when a block's driving force exceeds its
 /// friction) and ends unconverged instead of letting the block slide for its whole step limit.

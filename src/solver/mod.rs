@@ -220,29 +220,15 @@ impl Solver {
         let locked = self.stage.as_ref().map(|s| s.phase) == Some(equilibrium::Phase::Locked);
         let stage_mode = if locked { Mode::Static } else { Mode::Dynamic };
         let mode = std::mem::replace(&mut self.params.mode, stage_mode);
-        // Held, not only at a high friction: in a jointed rock mass a friction of 89° fed the
-        // ALM loop λ → friction → λ (tan 89° = 57) until λ overflowed (issue #14).
+        // Held by the contact law, not by a high friction: in a jointed rock mass a friction of
+        // 89° fed the ALM loop λ → friction → λ (tan 89° = 57) until λ overflowed (issue #14).
+        // Held, no contact slides (none starts or closes sliding either), so no friction acts.
         self.params.joints_held = locked;
-        // Every joint (`[joint]` and each set's) held at the stage's friction at least.
-        let frictions: Vec<f64> = self
-            .params
-            .joints_mut()
-            .map(|j| {
-                let phi = j.friction_angle;
-                if locked {
-                    j.friction_angle = equilibrium::STAGE_FRICTION_ANGLE.max(phi);
-                }
-                phi
-            })
-            .collect();
         let loads = self.point_loads_off();
         let result = self.advance(f64::INFINITY);
         self.restore_point_loads(loads);
         self.params.mode = mode;
         self.params.joints_held = false;
-        for (j, phi) in self.params.joints_mut().zip(frictions) {
-            j.friction_angle = phi;
-        }
         let (dt, settled) = result?;
         let stage = self.stage.as_mut().expect("the stage is under way");
         let ratio = equilibrium::unbalanced_ratio(
