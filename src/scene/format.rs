@@ -121,7 +121,9 @@ pub(super) struct RockMassSpec {
     pub(super) joint_sets: Vec<Spanned<JointSetSpec>>,
 }
 
-/// A region of a rock mass's domain, in the shape syntax of `[[blocks]]`.
+/// A region of a rock mass's domain, in the shape syntax of `[[blocks]]`. The shape keys are
+/// repeated from [`BlockSpec`] rather than shared by `#[serde(flatten)]`, which serde does not
+/// support together with `deny_unknown_fields`; [`ShapeSpec`] is what both hand on.
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(super) struct RegionSpec {
