@@ -108,11 +108,42 @@ pub fn add_shear_spring_stiffness(
     p_tau: f64,
 ) {
     let proj = nalgebra::Matrix3::identity() - n * n.transpose();
+    add_projected_stiffness(t, ta, tb, &proj, p_tau);
+}
+
+/// The stiffness of a tangential spring `k` acting on the part `proj` of Δu_ab = T_a D_i − T_b D_j.
+fn add_projected_stiffness(
+    t: &mut ContactStiffness,
+    ta: &Mat3x12,
+    tb: &Mat3x12,
+    proj: &nalgebra::Matrix3<f64>,
+    k: f64,
+) {
     let nta = proj * ta;
     let ntb = proj * tb;
-    t.k_ii += ta.transpose() * nta * p_tau;
-    t.k_ij -= ta.transpose() * ntb * p_tau;
-    t.k_jj += tb.transpose() * ntb * p_tau;
+    t.k_ii += ta.transpose() * nta * k;
+    t.k_ij -= ta.transpose() * ntb * k;
+    t.k_jj += tb.transpose() * ntb * k;
+}
+
+/// The tangent stiffness of sliding friction's direction. Friction of magnitude F along the slip
+/// s, F s/|s|, changes with s across τ = s/|s| at the rate (F/|s|)(I − ττᵀ) (see the test
+/// below): `lateral` = F/|s| acting on the tangential slip across τ, the Newton linearization of
+/// the direction. Without it the direction is a fixed point, τ taken from the last solve's slip;
+/// that iteration diverges while the slip of a step is small against the motion friction itself
+/// gives in a step, F Δt²/(2m): a slab starting to slide from rest yawed, its corners' slips
+/// turned against their friction, they stuck, and a stack of three slabs on a joint at a factor
+/// of safety of 0.67 stood.
+pub fn add_friction_tangent(
+    t: &mut ContactStiffness,
+    ta: &Mat3x12,
+    tb: &Mat3x12,
+    n: &Vec3,
+    tau: &Vec3,
+    lateral: f64,
+) {
+    let proj = nalgebra::Matrix3::identity() - n * n.transpose() - tau * tau.transpose();
+    add_projected_stiffness(t, ta, tb, &proj, lateral);
 }
 
 /// The force of the tangential spring of [`add_shear_spring_stiffness`] at D = 0:
@@ -141,6 +172,39 @@ pub fn add_friction(t: &mut ContactForces, ta: &Mat3x12, tb: &Mat3x12, tau: &Vec
 mod tests {
     use super::*;
     use crate::physics::geometry::{Mat3, rotation_xyz_degrees};
+
+    #[test]
+    fn the_friction_tangent_is_the_derivative_of_friction_along_the_slip() {
+        // F(s) = F s/|s| for tangential slips s (normal z), differentiated by central
+        // differences, against (F/|s|)(I − ττᵀ − nnᵀ) of `add_friction_tangent`.
+        let n = Vec3::z();
+        let f = 3.0e5;
+        let force = |s: &Vec3| s * (f / s.norm());
+        for s0 in [Vec3::new(1e-4, 0.0, 0.0), Vec3::new(-2e-3, 5e-4, 0.0)] {
+            let tau = s0.normalize();
+            let want = (nalgebra::Matrix3::identity() - n * n.transpose() - tau * tau.transpose())
+                * (f / s0.norm());
+            for (k, e) in [Vec3::x(), Vec3::y()].iter().enumerate() {
+                let h = 1e-7 * s0.norm();
+                let fd = (force(&(s0 + e * h)) - force(&(s0 - e * h))) / (2.0 * h);
+                let col = want.column(k);
+                assert!((fd - col).norm() < 1e-6 * want.norm(), "{fd} against {col}");
+            }
+        }
+        // In block coordinates: a pure translation of i across τ meets k⊥, along τ nothing.
+        let (ta, tb) = (
+            crate::physics::mechanics::displacement_matrix(&Vec3::new(0.3, -0.2, 0.0)),
+            crate::physics::mechanics::displacement_matrix(&Vec3::new(-0.5, 0.1, 0.0)),
+        );
+        let mut t = ContactStiffness::default();
+        add_friction_tangent(&mut t, &ta, &tb, &n, &Vec3::x(), 2.0);
+        let mut d = Vec12::zeros();
+        d[1] = 1.0;
+        assert!(((t.k_ii * d)[1] - 2.0).abs() < 1e-12);
+        d[1] = 0.0;
+        d[0] = 1.0;
+        assert!((t.k_ii * d).norm() < 1e-12);
+    }
 
     #[test]
     fn signed_distance_of_a_vertex_above_and_inside_a_face() {

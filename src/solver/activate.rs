@@ -140,6 +140,7 @@ fn activate_one(
         changed: false,
         shear: Vec3::zeros(),
         slip: Vec3::zeros(),
+        lateral: 0.0,
     };
     (active, old.is_none())
 }

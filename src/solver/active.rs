@@ -48,15 +48,20 @@ pub(crate) struct Active {
     pub shear: Vec3,
     /// Δu_ab projected on the tangent plane after the last solve.
     pub slip: Vec3,
+    /// k⊥ of a sliding contact (DDA-3a): the stiffness of its friction's direction across the
+    /// slip ([`crate::contact::kinematics::add_friction_tangent`]), N/m; 0 otherwise.
+    pub lateral: f64,
 }
 
 /// What a contact's stiffness depends on within an attempt (its kinematics are frozen): nothing
-/// if open; p_n if sliding; p_n and the reference point of the shear spring if locked.
+/// if open; p_n, τ and k⊥ if sliding; p_n and the reference point of the shear spring if locked.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct StiffnessKey {
     pub lock: bool,
     pub penalty: f64,
     pub reference: Vec3,
+    pub tau: Vec3,
+    pub lateral: f64,
 }
 
 impl Active {
@@ -160,6 +165,32 @@ impl Active {
         self.rec.reference = self.cand.xb - self.rec.tau * (friction / p_tau);
     }
 
+    /// Sets k⊥ of a sliding contact whose slip over the step is (or is expected to be) `slip`
+    /// long: its friction over that slip (the derivative of friction's direction), at most the
+    /// shear spring's p_τ, since a contact sliding is no stiffer across its slip than it is
+    /// locked. DDA-3p keeps Shi's friction, a load alone.
+    pub fn set_lateral(&mut self, p: &SolverParams, slip: f64) {
+        self.lateral = if p.method == Method::Alm && self.rec.state == ContactState::Slide {
+            let p_tau = p.contact.shear_penalty(self.rec.penalty);
+            let friction = self.sliding_friction(p);
+            if friction < p_tau * slip {
+                friction / slip
+            } else {
+                p_tau
+            }
+        } else {
+            0.0
+        };
+    }
+
+    /// k⊥ at the start of an attempt of length `dt`: the slip expected over the step is what
+    /// the blocks' relative tangential velocity gives.
+    pub fn predict_lateral(&mut self, p: &SolverParams, blocks: &[Block], dt: f64) {
+        let v = self.relative_velocity(blocks);
+        let n = self.cand.normal;
+        self.set_lateral(p, (v - n * n.dot(&v)).norm() * dt);
+    }
+
     /// See [`StiffnessKey`].
     pub fn stiffness_key(&self) -> Option<StiffnessKey> {
         match self.rec.state {
@@ -168,11 +199,15 @@ impl Active {
                 lock: false,
                 penalty: self.rec.penalty,
                 reference: Vec3::zeros(),
+                tau: self.rec.tau,
+                lateral: self.lateral,
             }),
             ContactState::Lock => Some(StiffnessKey {
                 lock: true,
                 penalty: self.rec.penalty,
                 reference: self.rec.reference,
+                tau: Vec3::zeros(),
+                lateral: 0.0,
             }),
         }
     }

@@ -5,8 +5,8 @@
 use super::active::{Active, StiffnessKey};
 use crate::contact::ContactState;
 use crate::contact::kinematics::{
-    ContactForces, ContactStiffness, add_friction, add_normal_force, add_normal_stiffness,
-    add_shear_spring_force, add_shear_spring_stiffness,
+    ContactForces, ContactStiffness, add_friction, add_friction_tangent, add_normal_force,
+    add_normal_stiffness, add_shear_spring_force, add_shear_spring_stiffness,
 };
 use crate::model::Block;
 use crate::params::{ContactParams, Method, SolverParams};
@@ -93,7 +93,8 @@ fn one_block(
 }
 
 /// The stiffness of one closed contact in the state `key`: normal (P10), and the shear spring
-/// (P15)/(5.7) if locked (sliding friction (P20) adds loads only).
+/// (P15)/(5.7) if locked, or the tangent of sliding friction's direction if sliding (friction
+/// (P20) itself is a load).
 pub(crate) fn contact_stiffness(
     cp: &ContactParams,
     blocks: &[Block],
@@ -106,6 +107,9 @@ pub(crate) fn contact_stiffness(
         let tb = c.tb_at(&key.reference, blocks);
         let p_tau = cp.shear_penalty(key.penalty);
         add_shear_spring_stiffness(&mut t, &c.ta, &tb, &c.cand.normal, p_tau);
+    } else if key.lateral > 0.0 {
+        let tb = c.tb_at(&c.cand.xb, blocks);
+        add_friction_tangent(&mut t, &c.ta, &tb, &c.cand.normal, &key.tau, key.lateral);
     }
     t
 }
@@ -227,25 +231,31 @@ mod tests {
     use crate::solver::Solver;
     use crate::solver::activate::{ActivationInputs, activate};
 
-    /// The rockfall column run into the impact (0.25 s), where vertex–face and edge–edge contacts
-    /// are active: the solver, its contacts for the next step, and their block pairs.
+    /// The rockfall column run into the impact (from 0.25 s on, to the first step where both
+    /// vertex–face and edge–edge contacts are active): the solver, its contacts for the next
+    /// step, and their block pairs.
     fn at_impact() -> (Solver, Vec<Active>, Vec<(usize, usize)>) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("scenes/rock_column_rockfall.toml");
         let s = crate::scene::load(&path).unwrap();
         let mut solver = Solver::new(s.model, s.params);
-        while solver.time < 0.25 {
+        let active = loop {
             solver.step().unwrap();
-        }
-        let (active, _) = activate(&ActivationInputs {
-            params: &solver.params,
-            blocks: &solver.model.blocks,
-            records: &solver.records,
-            initial_boxes: &solver.initial_boxes,
-            step: solver.step,
-            time: solver.time,
-            dt: solver.dt,
-        });
+            let (active, _) = activate(&ActivationInputs {
+                params: &solver.params,
+                blocks: &solver.model.blocks,
+                records: &solver.records,
+                initial_boxes: &solver.initial_boxes,
+                step: solver.step,
+                time: solver.time,
+                dt: solver.dt,
+            });
+            let has = |m| active.iter().any(|c| c.cand.mode() == m);
+            if solver.time >= 0.25 && has(ContactMode::EdgeEdge) && has(ContactMode::VertexFace) {
+                break active;
+            }
+            assert!(solver.time < 2.0, "no edge–edge contact by 2 s");
+        };
         let pairs = active
             .iter()
             .map(|c| (c.cand.key.i as usize, c.cand.key.j as usize))
@@ -266,7 +276,8 @@ mod tests {
     }
 
     /// The assembled global matrix — block terms, fixed-point springs, and contacts in all three
-    /// closed configurations (normal + shear spring, normal + friction) of both entrance modes —
+    /// closed configurations (normal + shear spring, normal + friction with and without its
+    /// direction's tangent) of both entrance modes —
     /// is symmetric and positive definite (reference §7), so Cholesky applies.
     #[test]
     fn assembled_matrix_is_symmetric_positive_definite() {
@@ -300,6 +311,8 @@ mod tests {
                 .cross(&Vec3::z())
                 .try_normalize(1e-9)
                 .unwrap_or(Vec3::x());
+            // Sliding with and without the tangent of friction's direction.
+            c.lateral = [0.0, 1e7, 1e9][n % 3];
         }
         assemble_fresh(&solver, &active, &mut k);
         let n = 12 * solver.model.blocks.len();

@@ -138,6 +138,11 @@ fn apply(inp: &CheckInputs, c: &mut Active, verdict: Transition, shear: Vec3) {
         Transition::Stick => c.stick(inp.params),
         Transition::Turn { tau } => c.rec.tau = tau,
     }
+    // k⊥ follows the slip this solve gave (a contact that has just begun to slide from
+    // locked has next to none: it starts as stiff across τ as its spring was).
+    if c.rec.state == ContactState::Slide {
+        c.set_lateral(inp.params, c.slip.norm());
+    }
 }
 
 /// At the open–close pass limit: if more than [`SETTLE_FRACTION`] of the contacts still changed
