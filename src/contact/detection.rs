@@ -2,7 +2,7 @@
 //! and the narrow phase's two entrance modes, vertex-to-face and edge-to-edge, with the merging
 //! of candidates that are one physical constraint.
 
-use super::{Candidate, ContactKey, DetectionParams, Shape};
+use super::{Alternative, Candidate, ContactKey, DetectionParams, Shape};
 use crate::physics::geometry::Vec3;
 
 /// Candidate block pairs by sort-and-sweep on the x extent of the enlarged bounding boxes.
@@ -69,13 +69,17 @@ fn face_triple(face: &[usize]) -> [usize; 3] {
 }
 
 /// Vertex-to-face candidates of the vertices of `a` against the faces of `b` (reference §4.3).
-/// Per vertex only the face with the largest signed gap is kept (the common-plane rule).
+/// Per vertex one candidate, on the face with the largest signed gap (the common-plane rule);
+/// among faces tied with it (a vertex on an edge of `b`), a face the vertex had a contact with
+/// in the last step, so that the contact keeps its history. The other faces in reach go with it
+/// as alternatives.
 fn vertex_face(
     ia: usize,
     a: &Shape,
     ib: usize,
     b: &Shape,
     p: &DetectionParams,
+    known: &dyn Fn(&ContactKey) -> bool,
     out: &mut Vec<Candidate>,
 ) {
     let reach = Reach::around(b, p.search_distance);
@@ -94,7 +98,7 @@ fn vertex_face(
         if !reach.holds(&pv, &pv) {
             continue;
         }
-        let mut best: Option<Candidate> = None;
+        let mut passing: Vec<Alternative> = Vec::new();
         let vertex_edge = a.topo.vertex_edges[vi]
             .iter()
             .map(|&ei| {
@@ -137,27 +141,52 @@ fn vertex_face(
             if !enters {
                 continue;
             }
-            if best.as_ref().is_some_and(|c| c.gap >= gap) {
-                continue;
-            }
             let [t1, t2, t3] = face_triple(face);
-            best = Some(Candidate {
-                key: ContactKey {
-                    i: ia as u32,
-                    j: ib as u32,
-                    mode: 0,
-                    feature_i: vi as u32,
-                    feature_j: fi as u32,
-                },
-                points: [pv, b.vertices[t1], b.vertices[t2], b.vertices[t3]],
+            passing.push(Alternative {
+                face: fi as u32,
+                corners: [b.vertices[t1], b.vertices[t2], b.vertices[t3]],
                 normal: n,
                 gap,
-                xa: pv,
-                xb: pv - n * gap,
             });
         }
-        out.extend(best);
+        out.extend(choose_face((ia, vi, pv), ib, passing, p.tie_distance, known));
     }
+}
+
+/// The candidate of vertex `vi` (at `xa`) of block `ia` among the faces of block `ib` it passed
+/// the tests with: the largest gap wins; among faces tied with it, a known contact's face, else
+/// the first.
+fn choose_face(
+    (ia, vi, xa): (usize, usize, Vec3),
+    ib: usize,
+    mut passing: Vec<Alternative>,
+    tie: f64,
+    known: &dyn Fn(&ContactKey) -> bool,
+) -> Option<Candidate> {
+    let key = |face: u32| ContactKey {
+        i: ia as u32,
+        j: ib as u32,
+        mode: 0,
+        feature_i: vi as u32,
+        feature_j: face,
+    };
+    let top = passing.iter().map(|f| f.gap).fold(f64::NEG_INFINITY, f64::max);
+    let largest = passing.iter().position(|f| f.gap == top)?;
+    let chosen = passing
+        .iter()
+        .position(|f| f.gap >= top - tie && known(&key(f.face)))
+        .unwrap_or(largest);
+    let f = passing.remove(chosen);
+    Some(Candidate {
+        key: key(f.face),
+        points: [xa, f.corners[0], f.corners[1], f.corners[2]],
+        normal: f.normal,
+        gap: f.gap,
+        xa,
+        xb: xa - f.normal * f.gap,
+        tied: passing.iter().any(|a| a.gap >= f.gap - tie),
+        alternatives: passing,
+    })
 }
 
 /// Unit vector in the plane of `face` (of a block with these vertices), perpendicular to the
@@ -252,6 +281,8 @@ fn edge_edge(
                 gap,
                 xa,
                 xb,
+                alternatives: Vec::new(),
+                tied: false,
             });
         }
     }
@@ -270,8 +301,8 @@ pub fn detect_pair(
     known: &dyn Fn(&ContactKey) -> bool,
 ) -> Vec<Candidate> {
     let mut all = Vec::new();
-    vertex_face(a, sa, b, sb, p, &mut all);
-    vertex_face(b, sb, a, sa, p, &mut all);
+    vertex_face(a, sa, b, sb, p, known, &mut all);
+    vertex_face(b, sb, a, sa, p, known, &mut all);
     edge_edge(a, sa, b, sb, p, &mut all);
     all.sort_by(|x, y| {
         known(&y.key)

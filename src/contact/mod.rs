@@ -75,6 +75,9 @@ pub struct DetectionParams {
     pub edge_margin: f64,
     /// Contacts of one block pair closer than this are one physical constraint.
     pub merge_distance: f64,
+    /// Faces whose gaps to a vertex differ by less than this are tied: the vertex sits on their
+    /// common edge (see [`Candidate::ambiguous`]).
+    pub tie_distance: f64,
 }
 
 impl DetectionParams {
@@ -90,6 +93,7 @@ impl DetectionParams {
             sin_parallel: sin3,
             edge_margin: 1e-3,
             merge_distance: 1e-3 * ds,
+            tie_distance: 1e-3 * ds,
         }
     }
 }
@@ -109,11 +113,50 @@ pub struct Candidate {
     pub xa: Vec3,
     /// Closest point of block j to `xa`.
     pub xb: Vec3,
+    /// V–F: the other faces of j the vertex is within reach of (they pass the point-in-face and
+    /// entrance tests); empty for E–E. The open–close check closes the contact on whichever
+    /// face the solution leaves the vertex least deep behind (see `Active::choose_face`).
+    pub alternatives: Vec<Alternative>,
+    /// V–F: the vertex sits on an edge or corner of block j, another face being as close as the
+    /// chosen one (within [`DetectionParams::tie_distance`]). Which face it would cross, the one
+    /// whose plane gives the larger gap after the motion (the common-plane rule), the motion
+    /// decides, and at rest it is unknown: at a junction of two persistent joints (four blocks
+    /// meeting along a line) the diagonal blocks touch along that line only, and a slab sliding
+    /// on one joint read the other joint's plane as a wall and stood.
+    pub tied: bool,
+}
+
+/// Another face of block j for a vertex–face candidate: the same vertex, its own plane.
+#[derive(Clone, Copy, Debug)]
+pub struct Alternative {
+    /// The face's index in block j.
+    pub face: u32,
+    /// P2…P4 of (5.1): three corners of the face.
+    pub corners: [Vec3; 3],
+    pub normal: Vec3,
+    pub gap: f64,
 }
 
 impl Candidate {
     pub fn mode(&self) -> ContactMode {
         self.key.mode()
+    }
+
+    /// Makes `alt` the candidate's face; the chosen face becomes an alternative.
+    pub fn switch_face(&mut self, alt: usize) {
+        let a = self.alternatives[alt];
+        let old = Alternative {
+            face: self.key.feature_j,
+            corners: [self.points[1], self.points[2], self.points[3]],
+            normal: self.normal,
+            gap: self.gap,
+        };
+        self.key.feature_j = a.face;
+        self.points = [self.points[0], a.corners[0], a.corners[1], a.corners[2]];
+        self.normal = a.normal;
+        self.gap = a.gap;
+        self.xb = self.xa - a.normal * a.gap;
+        self.alternatives[alt] = old;
     }
 }
 

@@ -93,6 +93,20 @@ fn activate_one(
         &bi.mp.centroid,
         &bj.mp.centroid,
     );
+    let alt_kin = cand
+        .alternatives
+        .iter()
+        .map(|a| {
+            let points = [cand.xa, a.corners[0], a.corners[1], a.corners[2]];
+            normal_kinematics(
+                cand.mode(),
+                &points,
+                &a.normal,
+                &bi.mp.centroid,
+                &bj.mp.centroid,
+            )
+        })
+        .collect();
     let old = inp.records.get(&cand.key).copied().or_else(|| {
         if cand.key.mode != 0 {
             return None;
@@ -115,6 +129,14 @@ fn activate_one(
         }
         None => new_record(inp, &cand, w0),
     };
+    // A vertex first seen on an edge of block j starts open: closed on one of the faces at that
+    // edge, it would hold the blocks against any motion across that face's plane, which may be
+    // the motion the other face allows. The open–close check closes it on the face the solution
+    // leaves it least deep behind, if it is behind all of them (`Active::reconsider_face`).
+    if old.is_none() && cand.tied && rec.state == ContactState::Lock {
+        rec.state = ContactState::Open;
+        rec.intact = false;
+    }
     if p.method == Method::Penalty {
         rec.penalty = p.contact.initial_penalty;
     }
@@ -124,6 +146,7 @@ fn activate_one(
     let active = Active {
         joint: joint_set(&cand.key, bi, bj),
         kin,
+        alt_kin,
         ta,
         young: bi.material.young_modulus.min(bj.material.young_modulus),
         w0,

@@ -15,6 +15,8 @@ use crate::physics::mechanics::{Mat3x12, Vec12, displacement_matrix};
 pub(crate) struct Active {
     pub cand: Candidate,
     pub kin: NormalKinematics,
+    /// The normal kinematics of each of `cand.alternatives`, in order.
+    pub alt_kin: Vec<NormalKinematics>,
     pub rec: ContactRecord,
     /// Record at the start of the step, restored when an attempt is redone.
     pub start: ContactRecord,
@@ -73,8 +75,17 @@ impl Active {
     /// The contact law's thresholds at this contact's w0.
     pub fn law(&self, p: &SolverParams) -> LawParams {
         let cp = &p.contact;
+        // A vertex on an edge of block j (`Candidate::tied`) closes only beyond the ALM's own
+        // tolerance ε1·d_n,max: below it, the few micrometres its blocks settle under load
+        // push it behind both faces at the edge, and closed on one of them, it would stop a
+        // slide along the other (see `reconsider_face`).
+        let close_penetration = if self.cand.tied {
+            (cp.close_threshold * self.w0).max(cp.eps1 * self.dn_max(p))
+        } else {
+            cp.close_threshold * self.w0
+        };
         LawParams {
-            close_penetration: cp.close_threshold * self.w0,
+            close_penetration,
             open_tension: cp.initial_penalty * (cp.open_threshold * self.w0),
             slip_tolerance: cp.open_threshold * self.w0,
             tan_phi: self.tan_phi(p),
@@ -189,6 +200,40 @@ impl Active {
         let v = self.relative_velocity(blocks);
         let n = self.cand.normal;
         self.set_lateral(p, (v - n * n.dot(&v)).norm() * dt);
+    }
+
+    /// The common-plane rule on the solution `d` for a V–F contact with alternative faces: the
+    /// vertex is outside block j when it is outside any one face, so the face that matters is
+    /// the one it ends least deep behind. An open contact takes that face (it closes on it if
+    /// even that one is penetrated); a closed one is clear, and returns true, when the vertex
+    /// ends beyond the closing threshold outside another face. Only an open contact changes
+    /// face: it has no stiffness in K, which is kept in step with each contact's geometry.
+    pub fn reconsider_face(&mut self, p: &SolverParams, d: &[f64]) -> bool {
+        let (i, j) = self.blocks();
+        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+        let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
+        let deepest = self
+            .alt_kin
+            .iter()
+            .map(|k| k.d0 + k.g_i.dot(&di) + k.g_j.dot(&dj))
+            .enumerate()
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        let Some((k, dn)) = deepest else {
+            return false;
+        };
+        if self.rec.state.is_closed() {
+            return dn < -p.contact.close_threshold * self.w0;
+        }
+        if dn < self.dn {
+            // A kept overlap belongs to the face it was measured on.
+            self.kin.d0 += self.rec.overlap;
+            self.rec.overlap = 0.0;
+            self.cand.switch_face(k);
+            std::mem::swap(&mut self.kin, &mut self.alt_kin[k]);
+            self.rec.normal = self.cand.normal;
+            self.dn = dn;
+        }
+        false
     }
 
     /// See [`StiffnessKey`].

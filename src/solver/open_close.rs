@@ -40,6 +40,7 @@ pub(crate) fn check(
     let mut changed = false;
     for c in active.iter_mut() {
         c.changed = false;
+        let clear = !c.frozen && c.reconsider_face(inp.params, d);
         let n = c.cand.normal;
         let du = c.relative_displacement(d, inp.blocks);
         c.slip = du - n * n.dot(&du);
@@ -47,7 +48,13 @@ pub(crate) fn check(
             c.rec.normal_force = c.force;
             continue;
         }
-        let (verdict, shear) = classify(inp, c, &du);
+        let (verdict, shear) = if clear {
+            // The vertex has left block j through another face: it is no longer in contact.
+            c.rec.normal_force = c.force;
+            (Transition::Open, Vec3::zeros())
+        } else {
+            classify(inp, c, &du)
+        };
         let before = c.rec.state;
         apply(inp, c, verdict, shear);
         if c.rec.state == before {
