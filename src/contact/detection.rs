@@ -149,7 +149,13 @@ fn vertex_face(
                 gap,
             });
         }
-        out.extend(choose_face((ia, vi, pv), ib, passing, p.tie_distance, known));
+        out.extend(choose_face(
+            (ia, vi, pv),
+            ib,
+            passing,
+            p.tie_distance,
+            known,
+        ));
     }
 }
 
@@ -170,7 +176,10 @@ fn choose_face(
         feature_i: vi as u32,
         feature_j: face,
     };
-    let top = passing.iter().map(|f| f.gap).fold(f64::NEG_INFINITY, f64::max);
+    let top = passing
+        .iter()
+        .map(|f| f.gap)
+        .fold(f64::NEG_INFINITY, f64::max);
     let largest = passing.iter().position(|f| f.gap == top)?;
     let chosen = passing
         .iter()
@@ -435,6 +444,55 @@ mod tests {
         ));
         let c = detect_pair(0, &shape(&lower), 1, &shape(&far), &params(), &|_| false);
         assert!(c.iter().all(|k| k.key.i != 1), "{c:#?}");
+    }
+
+    #[test]
+    fn the_diagonal_blocks_of_a_joint_junction_touch_on_tied_faces() {
+        // Four unit cubes meeting along the line x = 0, z = 1 (a bedding joint crossed by a
+        // vertical one): the lower-right and upper-left cubes touch along that line only. Each
+        // corner of one on that line is as close to the other's top (or bottom) face as to its
+        // side face: the candidate is tied and carries the other face as its alternative.
+        let lower_right = owned(box_vertices([1.0; 3], [0.5, 0.5, 0.5], &Mat3::identity()));
+        let upper_left = owned(box_vertices([1.0; 3], [-0.5, 0.5, 1.5], &Mat3::identity()));
+        let c = detect_pair(
+            0,
+            &shape(&lower_right),
+            1,
+            &shape(&upper_left),
+            &params(),
+            &|_| false,
+        );
+        assert!(!c.is_empty(), "they touch along the line");
+        for k in &c {
+            assert_eq!(k.mode(), ContactMode::VertexFace, "{k:#?}");
+            assert!(k.tied, "{k:#?}");
+            assert_eq!(k.alternatives.len(), 1, "{k:#?}");
+            let a = k.alternatives[0];
+            assert!(a.gap.abs() < 1e-12 && k.gap.abs() < 1e-12);
+            // One face is horizontal, the other vertical.
+            let crossed = k.normal.z.abs() * a.normal.x.abs() + k.normal.x.abs() * a.normal.z.abs();
+            assert!(crossed > 0.99, "{k:#?}");
+            // Switching makes the alternative the face, and back.
+            let mut s = k.clone();
+            s.switch_face(0);
+            assert!(
+                (s.normal - a.normal).norm() < 1e-15
+                    && (s.alternatives[0].normal - k.normal).norm() < 1e-15
+            );
+            assert!(
+                (s.xb - k.xa).norm() < 1e-12,
+                "the vertex touches both faces"
+            );
+        }
+        // A corner of a stacked cube in the middle of the face below is not tied.
+        let lower = owned(box_vertices([2.0; 3], [0.0, 0.0, 1.0], &Mat3::identity()));
+        let upper = owned(box_vertices([1.0; 3], [0.0, 0.0, 2.5], &Mat3::identity()));
+        let c = detect_pair(0, &shape(&lower), 1, &shape(&upper), &params(), &|_| false);
+        assert_eq!(c.len(), 4);
+        assert!(
+            c.iter().all(|k| !k.tied && k.alternatives.is_empty()),
+            "{c:#?}"
+        );
     }
 
     #[test]
