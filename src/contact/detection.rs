@@ -297,23 +297,6 @@ fn edge_edge(
     }
 }
 
-/// Two candidates of one block pair are one physical constraint: their contact points coincide
-/// (within [`DetectionParams::coincide_distance`]), or they lie within
-/// [`DetectionParams::merge_distance`] on one plane (normals, both taken out of the same block,
-/// within 10°).
-fn one_constraint(k: &Candidate, c: &Candidate, p: &DetectionParams) -> bool {
-    let d = ((k.xa + k.xb) / 2.0 - (c.xa + c.xb) / 2.0).norm();
-    if d <= p.coincide_distance {
-        return true;
-    }
-    let nk = if k.key.i == c.key.i {
-        k.normal
-    } else {
-        -k.normal
-    };
-    d <= p.merge_distance && nk.dot(&c.normal) > 10f64.to_radians().cos()
-}
-
 /// All contacts of one block pair, de-duplicated: candidates whose contact points coincide are
 /// one physical constraint (typically the i→j and j→i vertex–face contacts at the corners of two
 /// equal stacked faces). `known` tells which keys existed in the previous step: those win, so a
@@ -338,7 +321,11 @@ pub fn detect_pair(
     });
     let mut kept: Vec<Candidate> = Vec::with_capacity(all.len());
     for c in all {
-        if kept.iter().all(|k| !one_constraint(k, &c, p)) {
+        let mid = (c.xa + c.xb) / 2.0;
+        if kept
+            .iter()
+            .all(|k| ((k.xa + k.xb) / 2.0 - mid).norm() > p.merge_distance)
+        {
             kept.push(c);
         }
     }

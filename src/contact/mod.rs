@@ -73,18 +73,7 @@ pub struct DetectionParams {
     pub sin_parallel: f64,
     /// ε_e: margin of the edge parameters of an edge-edge contact.
     pub edge_margin: f64,
-    /// Contacts of one block pair whose points coincide within this (0.1 % of d_s) are one
-    /// physical constraint, whatever their planes.
-    pub coincide_distance: f64,
-    /// Contacts of one block pair on one plane (normals within 10°) within this of each other
-    /// (2 % of d_s) are one constraint too. At a joint junction the corners of two blocks that
-    /// slide together start at one point and drift apart by a fraction of a millimetre; merged
-    /// only within 0.1 % of d_s (0.1 mm in a 5 m stack), the i→j and j→i contacts there became
-    /// two, the same constraint twice with slightly different geometry, their multipliers
-    /// fought, (P21) raised both towards γE, and a stack of slabs cut by a 75° set jammed after
-    /// 4 cm of sliding (its twin at rest gained energy until the watchdog stopped it). Merged
-    /// at 2 % whatever their planes, an edge–edge contact gave way to a vertex–face one beside
-    /// it and the rockfall's toppled blocks met 27 mm deep before the edges were seen.
+    /// Contacts of one block pair closer than this are one physical constraint.
     pub merge_distance: f64,
     /// Faces whose gaps to a vertex differ by less than this are tied: the vertex sits on their
     /// common edge (see [`Candidate::ambiguous`]).
@@ -103,8 +92,7 @@ impl DetectionParams {
             sin_entrance: sin3,
             sin_parallel: sin3,
             edge_margin: 1e-3,
-            coincide_distance: 1e-3 * ds,
-            merge_distance: 2e-2 * ds,
+            merge_distance: 1e-3 * ds,
             tie_distance: 1e-3 * ds,
         }
     }
