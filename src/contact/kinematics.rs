@@ -18,6 +18,13 @@ pub struct NormalKinematics {
     pub a0: f64,
 }
 
+impl NormalKinematics {
+    /// d_n for the blocks' displacement increments `di`, `dj` (5.4).
+    pub fn penetration(&self, di: &Vec12, dj: &Vec12) -> f64 {
+        self.d0 + self.g_i.dot(di) + self.g_j.dot(dj)
+    }
+}
+
 /// Cofactor gradients c_r = ∂V0/∂P_r of the determinant (5.1)–(5.2).
 fn cofactors(p: &[Vec3; 4]) -> [Vec3; 4] {
     let [p1, p2, p3, p4] = *p;

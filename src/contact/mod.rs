@@ -76,7 +76,7 @@ pub struct DetectionParams {
     /// Contacts of one block pair closer than this are one physical constraint.
     pub merge_distance: f64,
     /// Faces whose gaps to a vertex differ by less than this are tied: the vertex sits on their
-    /// common edge (see [`Candidate::ambiguous`]).
+    /// common edge (see [`Candidate::tied`]).
     pub tie_distance: f64,
 }
 
@@ -115,7 +115,7 @@ pub struct Candidate {
     pub xb: Vec3,
     /// V–F: the other faces of j the vertex is within reach of (they pass the point-in-face and
     /// entrance tests); empty for E–E. The open–close check closes the contact on whichever
-    /// face the solution leaves the vertex least deep behind (see `Active::choose_face`).
+    /// face the solution leaves the vertex least deep behind (see `Active::reconsider_face`).
     pub alternatives: Vec<Alternative>,
     /// V–F: the vertex sits on an edge or corner of block j, another face being as close as the
     /// chosen one (within [`DetectionParams::tie_distance`]). Which face it would cross, the one

@@ -209,13 +209,11 @@ impl Active {
     /// ends beyond the closing threshold outside another face. Only an open contact changes
     /// face: it has no stiffness in K, which is kept in step with each contact's geometry.
     pub fn reconsider_face(&mut self, p: &SolverParams, d: &[f64]) -> bool {
-        let (i, j) = self.blocks();
-        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
-        let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
+        let (di, dj) = self.increments(d);
         let deepest = self
             .alt_kin
             .iter()
-            .map(|k| k.d0 + k.g_i.dot(&di) + k.g_j.dot(&dj))
+            .map(|k| k.penetration(&di, &dj))
             .enumerate()
             .min_by(|a, b| a.1.total_cmp(&b.1));
         let Some((k, dn)) = deepest else {
@@ -265,10 +263,17 @@ impl Active {
 
     /// Δu_ab = T_a D_i − T_b D_j (reference §6.1) for the solution `d`.
     pub fn relative_displacement(&self, d: &[f64], blocks: &[Block]) -> Vec3 {
-        let (i, j) = self.blocks();
-        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
-        let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
+        let (di, dj) = self.increments(d);
         self.ta * di - self.tb(blocks) * dj
+    }
+
+    /// The displacement increments D_i, D_j of the contact's two blocks in the solution `d`.
+    pub fn increments(&self, d: &[f64]) -> (Vec12, Vec12) {
+        let (i, j) = self.blocks();
+        (
+            Vec12::from_column_slice(&d[12 * i..12 * i + 12]),
+            Vec12::from_column_slice(&d[12 * j..12 * j + 12]),
+        )
     }
 
     /// The friction of a sliding contact from the previous iterate's normal force (5.8):

@@ -140,10 +140,8 @@ fn measure(p: &SolverParams, d: &[f64], active: &mut [Active]) -> (bool, bool) {
     let mut conv1 = true;
     let (mut dl2, mut l2) = (0.0, 0.0);
     for c in active.iter_mut() {
-        let (i, j) = c.blocks();
-        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
-        let dj = Vec12::from_column_slice(&d[12 * j..12 * j + 12]);
-        c.dn = c.kin.d0 + c.kin.g_i.dot(&di) + c.kin.g_j.dot(&dj);
+        let (di, dj) = c.increments(d);
+        c.dn = c.kin.penetration(&di, &dj);
         if c.rec.state == ContactState::Open {
             continue;
         }
