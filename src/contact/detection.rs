@@ -99,6 +99,10 @@ fn vertex_face(
             continue;
         }
         let mut passing: Vec<Alternative> = Vec::new();
+        // How far the vertex is outside b's face planes, at most (over all faces of b), and
+        // the widest slack a passing face allowed it.
+        let mut outside = f64::NEG_INFINITY;
+        let mut widest_slack = 0.0f64;
         let vertex_edge = a.topo.vertex_edges[vi]
             .iter()
             .map(|&ei| {
@@ -110,6 +114,7 @@ fn vertex_face(
             let n = b.face_normals[fi];
             let q0 = b.vertices[face[0]];
             let gap = (pv - q0).dot(&n);
+            outside = outside.max(gap);
             if gap < -p.max_penetration || gap > p.search_distance {
                 continue;
             }
@@ -148,6 +153,22 @@ fn vertex_face(
                 normal: n,
                 gap,
             });
+            widest_slack = widest_slack.max(slack);
+        }
+        // Block b is convex: a vertex outside the plane of any one of its faces is outside b,
+        // however deep it is behind the faces whose tests it passed. Within the slack of a face's
+        // outline it stands for the edge of its own block against that face (two equal faces
+        // stacked with a little twist have no vertex inside the other block, and their edges
+        // are parallel), but farther out it claims a depth that is not there: beside an acute
+        // edge of b (a 35° joint meeting an 80° one) a vertex sat 6 cm behind one face, within
+        // its outline, and as far outside the plane of the other; taken as a contact that deep
+        // it pushed two slabs of a jointed slope apart until the run diverged.
+        let top = passing
+            .iter()
+            .map(|f| f.gap)
+            .fold(f64::NEG_INFINITY, f64::max);
+        if top < -p.tie_distance && outside > widest_slack.max(p.tie_distance) {
+            continue;
         }
         out.extend(choose_face(
             (ia, vi, pv),
@@ -196,6 +217,42 @@ fn choose_face(
         tied: passing.iter().any(|a| a.gap >= f.gap - tie),
         alternatives: passing,
     })
+}
+
+/// The largest signed distance of `x` from the face planes of the convex block `b`: positive
+/// when `x` is outside `b`, a lower bound of its distance from `b`.
+fn farthest_outside(b: &Shape, x: &Vec3) -> f64 {
+    b.topo
+        .faces
+        .iter()
+        .zip(b.face_normals)
+        .map(|(face, n)| (x - b.vertices[face[0]]).dot(n))
+        .fold(f64::NEG_INFINITY, f64::max)
+}
+
+/// How much deeper a contact may claim a point to be, along its normal, than the point lies inside
+/// the other block: two edges crossing in their middles, along the bisector of an edge whose
+/// faces meet at 30° (the sharpest a joint set cuts against another here), cross 1 / cos 75° ≈
+/// 3.9 times deeper than their closest points lie behind the nearest face plane.
+const DEPTH_RATIO: f64 = 4.0;
+
+/// Edges crossing within this fraction of an end of one of them cross where a third face of
+/// that block meets the edge, and may cross deeper than the blocks overlap
+/// ([`crossing_is_overlap`]). Elsewhere the closest points lie on the planes of the faces at
+/// the other edge, and the crossing depth is the overlap's.
+const NEAR_END: f64 = 0.05;
+
+/// True when edges crossed by `−gap` along their common normal (closest points `xa` on `a`'s
+/// edge, `xb` on `b`'s) are an overlap of the blocks that the common normal resolves. Each
+/// closest point must lie inside the other block, and not far shallower than the crossing: a
+/// point inside a convex block is as far from its boundary as from the nearest face plane. Near
+/// an end of an edge, where other faces of its block meet, lines crossing 5 cm deep had their
+/// closest points 0.5–3.5 mm inside; pushed apart along the common normal, nearly in the plane
+/// of a face, the blocks of a jointed slope gained energy until the run diverged. The vertex at
+/// that end is in contact with a face instead (`vertex_face`).
+fn crossing_is_overlap(a: &Shape, b: &Shape, xa: &Vec3, xb: &Vec3, gap: f64, tie: f64) -> bool {
+    let depth = -farthest_outside(b, xa).max(farthest_outside(a, xb));
+    -gap <= DEPTH_RATIO * depth.max(0.0) + tie
 }
 
 /// Unit vector in the plane of `face` (of a block with these vertices), perpendicular to the
@@ -275,6 +332,10 @@ fn edge_edge(
             }
             let gap = (xa - xb).dot(&normal);
             if gap < -p.max_penetration || gap > p.search_distance {
+                continue;
+            }
+            let near_end = s.min(1.0 - s).min(t.min(1.0 - t)) < NEAR_END;
+            if near_end && gap < 0.0 && !crossing_is_overlap(a, b, &xa, &xb, gap, p.tie_distance) {
                 continue;
             }
             out.push(Candidate {
@@ -444,6 +505,88 @@ mod tests {
         ));
         let c = detect_pair(0, &shape(&lower), 1, &shape(&far), &params(), &|_| false);
         assert!(c.iter().all(|k| k.key.i != 1), "{c:#?}");
+    }
+
+    #[test]
+    fn a_vertex_beside_an_acute_edge_is_not_deep_in_the_block() {
+        // b: a blade, its sloping top meeting its base at 30° along the edge x = 4, z = 0. The
+        // vertex p is 3.2 cm behind the slope, within its outline, but 2 cm below the base's
+        // plane (more than the slack, 2 ε_e × 4 m), so outside b. Its block's edges run up
+        // along the slope's normal: the base, which it is outside of, fails the entrance test.
+        let (s30, c30) = (0.5, 3f64.sqrt() / 2.0);
+        let blade = owned(vec![
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(4.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 4.0 * s30 / c30),
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(4.0, 2.0, 0.0),
+            Vec3::new(0.0, 2.0, 4.0 * s30 / c30),
+        ]);
+        let n = Vec3::new(s30, 0.0, c30);
+        let p = Vec3::new(4.0 - 0.03, 1.0, -0.02);
+        let (u, w) = (Vec3::y(), n.cross(&Vec3::y()));
+        let tip = owned(vec![
+            p,
+            p + n + u * 0.3,
+            p + n - u * 0.3 + w * 0.3,
+            p + n - w * 0.3,
+        ]);
+        let gap = (p - Vec3::new(4.0, 0.0, 0.0)).dot(&n);
+        assert!(gap < -0.03 && gap > -params().max_penetration, "{gap}");
+        let c = detect_pair(0, &shape(&blade), 1, &shape(&tip), &params(), &|_| false);
+        assert!(c.iter().all(|k| (k.xa - p).norm() > 1e-9), "{c:#?}");
+        // Moved up by 2.5 cm, p is inside b, 5 mm from the base: a contact 7.5 mm deep.
+        let q = p + Vec3::z() * 0.025;
+        let tip = owned(vec![
+            q,
+            q + n + u * 0.3,
+            q + n - u * 0.3 + w * 0.3,
+            q + n - w * 0.3,
+        ]);
+        let c = detect_pair(0, &shape(&blade), 1, &shape(&tip), &params(), &|_| false);
+        let k = c
+            .iter()
+            .find(|k| (k.xa - q).norm() < 1e-9)
+            .expect("q is a contact");
+        assert!((k.gap - (gap + 0.025 * c30)).abs() < 1e-12, "{k:#?}");
+    }
+
+    #[test]
+    fn a_corner_overhanging_a_face_edge_within_the_slack_bears_on_the_face() {
+        // The upper cube sits 1 mm into the lower one and 0.5 mm past its edge x = 1: its
+        // corners there are outside the lower cube (beyond the side face's plane, which their
+        // edges along −x dive through), yet they stand for the upper cube's bottom edge on the
+        // top face, 1 mm deep (no edge of the upper cube crosses one of the lower's).
+        let lower = owned(box_vertices([1.0; 3], [0.5, 0.5, 0.5], &Mat3::identity()));
+        let upper = owned(box_vertices(
+            [1.0; 3],
+            [0.5005, 0.5, 1.499],
+            &Mat3::identity(),
+        ));
+        let c = detect_pair(0, &shape(&lower), 1, &shape(&upper), &params(), &|_| false);
+        for y in [0.0, 1.0] {
+            let k = c
+                .iter()
+                .find(|k| (k.xa - Vec3::new(1.0005, y, 0.999)).norm() < 1e-9)
+                .unwrap_or_else(|| panic!("the corner at y = {y} is a contact: {c:#?}"));
+            assert!((k.gap + 1e-3).abs() < 1e-12 && (k.normal - Vec3::z()).norm() < 1e-12);
+        }
+    }
+
+    #[test]
+    fn crossed_edges_are_an_overlap_only_as_deep_as_their_points_lie_inside() {
+        // A point 1 mm under the top of a unit cube, near its corner: edges crossing there
+        // 3 mm deep along a slanted normal are an overlap; 5 cm deep, they are not.
+        let cube = owned(box_vertices([1.0; 3], [0.5, 0.5, 0.5], &Mat3::identity()));
+        let b = shape(&cube);
+        let tie = params().tie_distance;
+        let xa = Vec3::new(0.9, 0.9, 0.999);
+        let xb = Vec3::new(0.5, 0.5, 0.5);
+        assert!(crossing_is_overlap(&b, &b, &xa, &xb, -0.003, tie));
+        assert!(!crossing_is_overlap(&b, &b, &xa, &xb, -0.05, tie));
+        // Outside the block, no depth at all is.
+        let out = Vec3::new(1.01, 0.5, 0.5);
+        assert!(!crossing_is_overlap(&b, &b, &out, &xb, -0.003, tie));
     }
 
     #[test]

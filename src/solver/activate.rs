@@ -149,6 +149,7 @@ fn activate_one(
         alt_kin,
         ta,
         young: bi.material.young_modulus.min(bj.material.young_modulus),
+        weight: lighter_weight(bi, bj, p),
         w0,
         start: rec,
         rec,
@@ -166,6 +167,14 @@ fn activate_one(
         lateral: 0.0,
     };
     (active, old.is_none())
+}
+
+/// The weight of the lighter of two blocks, a fixed block not counted, N.
+fn lighter_weight(bi: &Block, bj: &Block, p: &SolverParams) -> f64 {
+    let g = Vec3::from(p.gravity).norm();
+    let mass = |b: &Block| if b.fixed { f64::INFINITY } else { b.mass };
+    let m = mass(bi).min(mass(bj));
+    if m.is_finite() { m * g } else { 0.0 }
 }
 
 /// The record of a contact seen for the first time: closed (locked) if it is touching or

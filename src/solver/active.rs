@@ -11,6 +11,10 @@ use crate::params::{ContactParams, Method, SolverParams};
 use crate::physics::geometry::Vec3;
 use crate::physics::mechanics::{Mat3x12, Vec12, displacement_matrix};
 
+/// How far beyond the joint's strength [`Active::cap_shear`] lets a locked contact's spring
+/// pull within the ALM loop.
+const SHEAR_CAP: f64 = 2.0;
+
 /// A contact inside a step.
 pub(crate) struct Active {
     pub cand: Candidate,
@@ -26,6 +30,9 @@ pub(crate) struct Active {
     pub pair: usize,
     /// The smaller Young's modulus of the two blocks: the cap γE of (P21b).
     pub young: f64,
+    /// The weight of the lighter free block of the two, N: the scale of a shear spring's
+    /// force below which [`Active::cap_shear`] leaves it alone.
+    pub weight: f64,
     /// The joint set the contact lies on (`None`: `[joint]`); see [`SolverParams::joint_of`].
     pub joint: Option<u16>,
     /// Shi's w0 of the contact's group (`crate::contact::groups`), m: the length its
@@ -174,6 +181,34 @@ impl Active {
         let p_tau = p.contact.shear_penalty(self.rec.penalty);
         self.rec.state = ContactState::Lock;
         self.rec.reference = self.cand.xb - self.rec.tau * (friction / p_tau);
+    }
+
+    /// Shortens a locked contact's shear spring to [`SHEAR_CAP`] times what the joint can hold,
+    /// N tan φ (+ cohesion while intact), N the larger of the last solve's and λ: the stick
+    /// update of the ALM loop ([`super::alm`]) moves the reference point by every slip the
+    /// contact makes, and where the contacts around it are in the wrong states, so that it
+    /// keeps slipping, the spring's force grew without bound within the loop: 3 GN at contacts
+    /// of 1 MN blocks of a jointed slope, which the step then turned into 100 MJ of kinetic
+    /// energy at any Δt. The open–close check lets a contact whose spring is beyond the strength
+    /// slide. (Capped at the strength itself, λ still converging, the corners of the struck wall
+    /// in `tests/rockfall.rs` slipped and its rock stuck instead of rebounding.)
+    pub fn cap_shear(&mut self, p: &SolverParams) {
+        let n = self.cand.normal;
+        let r = self.cand.xa - self.rec.reference;
+        let along = r - n * n.dot(&r);
+        let p_tau = p.contact.shear_penalty(self.rec.penalty);
+        let cohesion = if self.rec.intact {
+            p.joint_of(self.joint).cohesion * self.rec.cohesion_area
+        } else {
+            0.0
+        };
+        let strength = (SHEAR_CAP
+            * (self.force.max(self.rec.lambda).max(0.0) * self.tan_phi(p) + cohesion))
+            .max(self.weight);
+        let force = p_tau * along.norm();
+        if force > strength {
+            self.rec.reference += along * (1.0 - strength / force);
+        }
     }
 
     /// Sets k⊥ of a sliding contact whose slip over the step is (or is expected to be) `slip`

@@ -237,6 +237,9 @@ fn absorb_stick_slip(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
         if c.rec.state == ContactState::Lock {
             let slip = tangential_slip(c, d, inp.blocks);
             c.rec.reference -= slip;
+            if !inp.params.joints_held && !inp.first_step {
+                c.cap_shear(inp.params);
+            }
         }
     }
 }

@@ -138,6 +138,45 @@ pub(crate) fn contact_stats(active: &[Active], closed: &[ContactSnapshot]) -> St
     }
 }
 
+/// The kinetic, gravitational and elastic energy the blocks would have after the solution `d`
+/// of a step of `dt`, and the work the point loads would do over it, J: what
+/// [`commit_blocks`] then [`with_energy`] give, without moving anything (the mass matrices
+/// and volumes of the start of the step, the stress unrotated: a check's accuracy).
+pub(crate) fn energy_after(
+    blocks: &[Block],
+    d: &[f64],
+    dt: f64,
+    scheme: &Scheme,
+    gravity: [f64; 3],
+) -> ([f64; 3], f64) {
+    let g = Vec3::from(gravity);
+    let (mut energy, mut work) = ([0.0; 3], 0.0);
+    for (i, b) in blocks.iter().enumerate() {
+        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+        let de = di.fixed_rows::<6>(6).into_owned();
+        let strain = b.strain + de;
+        let stress = b.stress + b.elasticity * de;
+        energy[2] += 0.5 * b.mp.volume * stress.dot(&strain);
+        if b.fixed {
+            continue;
+        }
+        let v = scheme.advance(&b.kinematics(), &di, dt).velocity;
+        energy[0] += 0.5 * (v.transpose() * b.mass_matrix * v)[0];
+        // The centroid moves by the step's translation (1.3).
+        let centroid = b.mp.centroid + di.fixed_rows::<3>(0);
+        energy[1] -= b.mass * g.dot(&centroid);
+        if !b.loads.is_empty() {
+            let map = StepMap::new(b.mp.centroid, &di);
+            work += b
+                .loads
+                .iter()
+                .map(|(pt, f)| f.dot(&(map.apply(pt) - pt)))
+                .sum::<f64>();
+        }
+    }
+    (energy, work)
+}
+
 /// Kinetic, gravitational and elastic energy of the model, into `s`.
 pub(crate) fn with_energy(mut s: StepStats, blocks: &[Block], gravity: [f64; 3]) -> StepStats {
     let g = Vec3::from(gravity);

@@ -29,6 +29,7 @@ use activate::{ActivationInputs, activate};
 use active::Active;
 use attempt::{AttemptInputs, Solved, attempt};
 use counters::{Counters, Stopwatch, debug_log};
+use step_control::Retry;
 use watchdog::EnergyWatch;
 
 use crate::contact::ContactKey;
@@ -394,7 +395,21 @@ impl Solver {
                 first_step: self.step == 0,
                 at_floor,
             };
-            match attempt(&inputs, kmat, &mut self.linear.chol, active, &mut counters) {
+            let result = attempt(&inputs, kmat, &mut self.linear.chol, active, &mut counters)
+                .and_then(|solved| {
+                    if at_floor {
+                        return Ok(solved);
+                    }
+                    check_energy(
+                        &self.params,
+                        &self.model.blocks,
+                        self.energy.as_ref(),
+                        &scheme,
+                        (&solved.d, dt),
+                    )?;
+                    Ok(solved)
+                });
+            match result {
                 Ok(solved) => {
                     counters.totals.unconverged_steps += solved.settled as u64;
                     return Ok((solved, dt, cuts, counters.factorizations));
@@ -481,4 +496,36 @@ impl Solver {
     pub fn contacts(&self) -> &[ContactSnapshot] {
         &self.contacts
     }
+}
+
+/// `Err` when the solution `d` of a dynamic step of `dt` would create energy (see
+/// [`EnergyWatch::step_gain`]); static steps are not checked. The dynamic phase of the
+/// equilibrium stage is, against the energy the model has now: a block thrown 2 cm up by a
+/// bad step there was frozen in the air when the stage ended, and fell as the run began.
+fn check_energy(
+    params: &SolverParams,
+    blocks: &[crate::model::Block],
+    watch: Option<&EnergyWatch>,
+    scheme: &Scheme,
+    (d, dt): (&[f64], f64),
+) -> Result<(), Retry> {
+    if params.mode != Mode::Dynamic {
+        return Ok(());
+    }
+    let now = commit::with_energy(StepStats::default(), blocks, params.gravity);
+    let stage_watch;
+    let watch = match watch {
+        Some(w) => w,
+        None => {
+            stage_watch = EnergyWatch::begin(blocks, params.gravity, &now);
+            &stage_watch
+        }
+    };
+    let before = [now.kinetic_energy, now.potential_energy, now.elastic_energy];
+    let (after, work) = commit::energy_after(blocks, d, dt, scheme, params.gravity);
+    let ratio = watch.step_gain(&before, &after, work);
+    if ratio > 1.0 {
+        return Err(Retry::EnergyGain(ratio));
+    }
+    Ok(())
 }

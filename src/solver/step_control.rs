@@ -25,6 +25,9 @@ pub(crate) enum Retry {
     Penetration(f64),
     /// The factorization failed or the solution is not finite.
     NotFinite,
+    /// The solution would create this many times the energy a step may gain
+    /// ([`super::watchdog::EnergyWatch::step_gain`]).
+    EnergyGain(f64),
 }
 
 impl Retry {
@@ -33,6 +36,7 @@ impl Retry {
         match self {
             Retry::OpenClose => unreachable!("settled at the floor"),
             Retry::NotFinite => "the solution is not finite".to_string(),
+            Retry::EnergyGain(_) => unreachable!("accepted at the floor"),
             Retry::Penetration(r) => format!(
                 "a contact penetrated {} times its contact window at the minimum time step",
                 short(*r)
@@ -51,6 +55,7 @@ impl Retry {
             Retry::Displacement(r) => format!("displacement r={r:.2}"),
             Retry::Penetration(r) => format!("penetration r={r:.2}"),
             Retry::NotFinite => "not finite".to_string(),
+            Retry::EnergyGain(r) => format!("energy gain r={r:.2}"),
         }
     }
 

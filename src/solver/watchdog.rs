@@ -18,6 +18,13 @@ use crate::text::short;
 /// The energy a run may gain, as a fraction of the energy it has available (see the module doc).
 pub const ENERGY_GAIN_LIMIT: f64 = 0.05;
 
+/// A step may gain at most this many times the kinetic energy it starts and ends with (see
+/// [`EnergyWatch::step_gain`]).
+pub const STEP_GAIN_LIMIT: f64 = 1.0;
+
+/// ... and in any case this fraction of the energy the model has available.
+pub const STEP_GAIN_FLOOR: f64 = 1e-4;
+
 /// Below this scale, J, a model has nothing that moves it: round-off is not a gain.
 const ENERGY_FLOOR: f64 = 1e-6;
 
@@ -113,6 +120,26 @@ impl EnergyWatch {
         ))
     }
 
+    /// The energy a step would gain, from the kinetic, gravitational and elastic energy
+    /// `before` and `after` it and the work of the loads over it, as a multiple of what a step
+    /// may gain: [`STEP_GAIN_LIMIT`] times its kinetic energy before and after, at least
+    /// [`STEP_GAIN_FLOOR`] of the model's available energy. Above 1 the step creates energy
+    /// and is redone shorter (NaN counts as infinite).
+    ///
+    /// Why per step, besides the run's balance: an open–close iteration that ends in a wrong
+    /// set of states (settled after cycling) can hand a step tens of MJ of elastic energy at
+    /// once, from a model moving with a few kJ; redone at a third of the Δt it does not. A
+    /// step's own gain is bounded: penalty springs that were not counted (the energy of a
+    /// contact's penetration) give back at most the kinetic energy the step ends with.
+    pub fn step_gain(&self, before: &[f64; 3], after: &[f64; 3], work: f64) -> f64 {
+        let gain = after.iter().sum::<f64>() - before.iter().sum::<f64>() - work;
+        let allowed = (STEP_GAIN_LIMIT * (before[0] + after[0]))
+            .max(STEP_GAIN_FLOOR * (self.available + self.work_scale))
+            .max(ENERGY_FLOOR);
+        let ratio = gain / allowed;
+        if ratio.is_nan() { f64::INFINITY } else { ratio }
+    }
+
     /// The gain so far as a fraction of the energy available (for tests and the debug log).
     pub fn gain_ratio(&self, stats: &StepStats) -> f64 {
         let now = stats.kinetic_energy + stats.potential_energy + stats.elastic_energy;
@@ -153,6 +180,26 @@ mod tests {
         assert!(w.check(&stats(f64::NAN, 1e6, 0.0)).is_err());
         // The reference of the potential energy does not matter, only its change.
         assert!(w.check(&stats(0.0, 1e6 + 60.0, 0.0)).is_err());
+    }
+
+    #[test]
+    fn a_step_may_gain_its_kinetic_energy_or_a_small_part_of_the_available() {
+        let w = watch(1e6);
+        // The floor: 1e-4 of 1e6 J.
+        assert!(w.step_gain(&[0.0, 1e6, 0.0], &[0.0, 1e6, 99.0], 0.0) < 1.0);
+        assert!(w.step_gain(&[0.0, 1e6, 0.0], &[0.0, 1e6, 101.0], 0.0) > 1.0);
+        // A released spring: the kinetic energy comes back, nothing else.
+        assert!(w.step_gain(&[1e3, 1e6, 0.0], &[5e3, 1e6, 0.0], 0.0) < 1.0);
+        // A step that strains the blocks by far more than the motion carried.
+        let r = w.step_gain(&[1e3, 1e6, 0.0], &[2e3, 1e6, 3e4], 0.0);
+        assert!((r - 3.1e4 / 3e3).abs() < 1e-9, "{r}");
+        // The loads' work is not a gain; a loss never is; NaN is.
+        assert!(w.step_gain(&[0.0, 1e6, 0.0], &[5e3, 1e6, 0.0], 5e3) <= 0.0);
+        assert!(w.step_gain(&[5e3, 1e6, 0.0], &[0.0, 1e6 - 10.0, 0.0], 0.0) < 0.0);
+        assert_eq!(
+            w.step_gain(&[0.0, 1e6, 0.0], &[f64::NAN, 1e6, 0.0], 0.0),
+            f64::INFINITY
+        );
     }
 
     #[test]
