@@ -335,7 +335,11 @@ fn edge_edge(
                 continue;
             }
             let near_end = s.min(1.0 - s).min(t.min(1.0 - t)) < NEAR_END;
-            if near_end && gap < 0.0 && !crossing_is_overlap(a, b, &xa, &xb, gap, p.tie_distance) {
+            if p.check_crossing_depth
+                && near_end
+                && gap < 0.0
+                && !crossing_is_overlap(a, b, &xa, &xb, gap, p.tie_distance)
+            {
                 continue;
             }
             out.push(Candidate {

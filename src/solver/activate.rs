@@ -51,7 +51,10 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let known = |k: &ContactKey| inp.records.contains_key(k);
     let mut cands: Vec<Candidate> = Vec::new();
     for &(a, b) in &groups.pairs {
-        let dp = DetectionParams::new(groups.pair_w0(a, b), p.max_displacement_ratio);
+        let dp = DetectionParams {
+            check_crossing_depth: p.method == Method::Alm,
+            ..DetectionParams::new(groups.pair_w0(a, b), p.max_displacement_ratio)
+        };
         cands.extend(detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known));
     }
     // Contact transfer: a vertex that slid onto an adjacent, almost coplanar face of the same
