@@ -146,7 +146,12 @@ impl Block {
 
     /// ½ vᵀ M v.
     pub fn kinetic_energy(&self) -> f64 {
-        0.5 * (self.velocity.transpose() * self.mass_matrix * self.velocity)[0]
+        self.kinetic_energy_at(&self.velocity)
+    }
+
+    /// ½ vᵀ M v at the DOF rates `v` (M of the block as it is).
+    pub fn kinetic_energy_at(&self, v: &Vec12) -> f64 {
+        0.5 * (v.transpose() * self.mass_matrix * v)[0]
     }
 
     /// Largest distance from the centroid to a vertex.

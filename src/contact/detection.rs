@@ -529,24 +529,22 @@ mod tests {
         let n = Vec3::new(s30, 0.0, c30);
         let p = Vec3::new(4.0 - 0.03, 1.0, -0.02);
         let (u, w) = (Vec3::y(), n.cross(&Vec3::y()));
-        let tip = owned(vec![
-            p,
-            p + n + u * 0.3,
-            p + n - u * 0.3 + w * 0.3,
-            p + n - w * 0.3,
-        ]);
+        let tip_at = |x: Vec3| {
+            owned(vec![
+                x,
+                x + n + u * 0.3,
+                x + n - u * 0.3 + w * 0.3,
+                x + n - w * 0.3,
+            ])
+        };
+        let tip = tip_at(p);
         let gap = (p - Vec3::new(4.0, 0.0, 0.0)).dot(&n);
         assert!(gap < -0.03 && gap > -params().max_penetration, "{gap}");
         let c = detect_pair(0, &shape(&blade), 1, &shape(&tip), &params(), &|_| false);
         assert!(c.iter().all(|k| (k.xa - p).norm() > 1e-9), "{c:#?}");
         // Moved up by 2.5 cm, p is inside b, 5 mm from the base: a contact 7.5 mm deep.
         let q = p + Vec3::z() * 0.025;
-        let tip = owned(vec![
-            q,
-            q + n + u * 0.3,
-            q + n - u * 0.3 + w * 0.3,
-            q + n - w * 0.3,
-        ]);
+        let tip = tip_at(q);
         let c = detect_pair(0, &shape(&blade), 1, &shape(&tip), &params(), &|_| false);
         let k = c
             .iter()

@@ -197,14 +197,9 @@ impl Active {
         let r = self.cand.xa - self.rec.reference;
         let along = r - n * n.dot(&r);
         let p_tau = p.contact.shear_penalty(self.rec.penalty);
-        let cohesion = if self.rec.intact {
-            p.joint_of(self.joint).cohesion * self.rec.cohesion_area
-        } else {
-            0.0
-        };
         let strength = (SHEAR_CAP
-            * (self.force.max(self.rec.lambda).max(0.0) * self.tan_phi(p) + cohesion))
-            .max(self.weight);
+            * (self.force.max(self.rec.lambda).max(0.0) * self.tan_phi(p) + self.cohesion(p)))
+        .max(self.weight);
         let force = p_tau * along.norm();
         if force > strength {
             self.rec.reference += along * (1.0 - strength / force);
@@ -323,6 +318,16 @@ impl Active {
             self.rec.normal_force.max(0.0)
         };
         n_prev * self.tan_phi(p)
+    }
+
+    /// The cohesive force the contact holds, N: its joint's cohesion over its share of the
+    /// joint's area while it is intact (closed since t = 0), none once it has opened or slid.
+    pub fn cohesion(&self, p: &SolverParams) -> f64 {
+        if self.rec.intact {
+            p.joint_of(self.joint).cohesion * self.rec.cohesion_area
+        } else {
+            0.0
+        }
     }
 
     /// tan φ of the contact's joint.

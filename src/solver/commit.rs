@@ -4,6 +4,8 @@
 
 use std::collections::HashMap;
 
+use nalgebra::Vector6;
+
 use super::active::Active;
 use crate::contact::record::ContactRecord;
 use crate::contact::{ContactKey, ContactState};
@@ -154,17 +156,14 @@ pub(crate) fn energy_after(
     for (i, b) in blocks.iter().enumerate() {
         let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
         let de = di.fixed_rows::<6>(6).into_owned();
-        let strain = b.strain + de;
-        let stress = b.stress + b.elasticity * de;
-        energy[2] += 0.5 * b.mp.volume * stress.dot(&strain);
+        energy[2] += elastic_energy(b, &(b.stress + b.elasticity * de), &(b.strain + de));
         if b.fixed {
             continue;
         }
         let v = scheme.advance(&b.kinematics(), &di, dt).velocity;
-        energy[0] += 0.5 * (v.transpose() * b.mass_matrix * v)[0];
+        energy[0] += b.kinetic_energy_at(&v);
         // The centroid moves by the step's translation (1.3).
-        let centroid = b.mp.centroid + di.fixed_rows::<3>(0);
-        energy[1] -= b.mass * g.dot(&centroid);
+        energy[1] += potential_energy(b, &(b.mp.centroid + di.fixed_rows::<3>(0)), &g);
         if !b.loads.is_empty() {
             let map = StepMap::new(b.mp.centroid, &di);
             work += b
@@ -188,11 +187,21 @@ pub(crate) fn with_energy(mut s: StepStats, blocks: &[Block], gravity: [f64; 3])
     s.potential_energy = blocks
         .iter()
         .filter(|b| !b.fixed)
-        .map(|b| -b.mass * g.dot(&b.mp.centroid))
+        .map(|b| potential_energy(b, &b.mp.centroid, &g))
         .sum();
     s.elastic_energy = blocks
         .iter()
-        .map(|b| 0.5 * b.mp.volume * b.stress.dot(&b.strain))
+        .map(|b| elastic_energy(b, &b.stress, &b.strain))
         .sum();
     s
+}
+
+/// −m g·c: the gravitational energy of block `b` with its centroid at `centroid`, J.
+fn potential_energy(b: &Block, centroid: &Vec3, g: &Vec3) -> f64 {
+    -b.mass * g.dot(centroid)
+}
+
+/// ½ V σ·ε: the strain energy of block `b` at this stress and strain, J.
+fn elastic_energy(b: &Block, stress: &Vector6<f64>, strain: &Vector6<f64>) -> f64 {
+    0.5 * b.mp.volume * stress.dot(strain)
 }

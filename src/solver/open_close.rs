@@ -105,11 +105,7 @@ fn classify(inp: &CheckInputs, c: &mut Active, du: &Vec3) -> (Transition, Vec3) 
         normal_force: c.force,
         shear,
         shear_stiffness: cp.shear_penalty(c.rec.penalty),
-        cohesion: if c.rec.intact {
-            inp.params.joint_of(c.joint).cohesion * c.rec.cohesion_area
-        } else {
-            0.0
-        },
+        cohesion: c.cohesion(inp.params),
         slip: c.slip,
         tau: c.rec.tau,
         lambda: c.rec.lambda,
