@@ -19,9 +19,6 @@ use crate::params::{Method, SolverParams};
 use crate::physics::geometry::{Vec3, planar_hull_area};
 use crate::physics::mechanics::displacement_matrix;
 
-/// Fraction of a kept overlap released each step (see [`keep_overlap`]).
-const OVERLAP_RELEASE: f64 = 0.1;
-
 /// What activation reads.
 pub(crate) struct ActivationInputs<'a> {
     pub params: &'a SolverParams,
@@ -52,7 +49,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let mut cands: Vec<Candidate> = Vec::new();
     for &(a, b) in &groups.pairs {
         let dp = DetectionParams {
-            check_crossing_depth: p.method == Method::Alm,
+            check_claimed_depth: p.method == Method::Alm,
             ..DetectionParams::new(groups.pair_w0(a, b), p.max_displacement_ratio)
         };
         cands.extend(detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known));
@@ -168,6 +165,7 @@ fn activate_one(
         shear: Vec3::zeros(),
         slip: Vec3::zeros(),
         lateral: 0.0,
+        released: 0.0,
     };
     (active, old.is_none())
 }
@@ -210,8 +208,8 @@ fn new_record(inp: &ActivationInputs, cand: &Candidate, w0: f64) -> ContactRecor
 /// slipped past detection, or an open contact whose linearised gap was wrong) keeps that overlap
 /// instead of having it pushed out in one step: resolved within one step, an overlap of
 /// millimetres takes meganewtons and comes back as kinetic energy the system never had. The
-/// overlap is taken out of d0; it shrinks as the blocks separate and by [`OVERLAP_RELEASE`] of
-/// itself a step.
+/// overlap is taken out of d0; it shrinks as the blocks separate, and each attempt gives back a
+/// part of it in proportion to its Δt ([`Active::release_overlap`]).
 fn keep_overlap(
     inp: &ActivationInputs,
     cand: &Candidate,
@@ -222,7 +220,7 @@ fn keep_overlap(
 ) {
     let p = inp.params;
     let overlap_tol = p.contact.eps1 * max_step_penetration(p, w0);
-    rec.overlap = (rec.overlap * (1.0 - OVERLAP_RELEASE)).min(d0.max(0.0));
+    rec.overlap = rec.overlap.min(d0.max(0.0));
     if unseen && *d0 > overlap_tol {
         rec.overlap = *d0;
         if debug_log() {
