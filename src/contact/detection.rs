@@ -170,21 +170,10 @@ fn vertex_face(
         if top < -p.tie_distance && outside > widest_slack.max(p.tie_distance) {
             continue;
         }
-        // Nor may a vertex outside b, within that slack, claim to be far deeper than it is
-        // outside: passing the edge of the face it slid along, beyond the slack, a vertex
-        // beside an acute edge of b kept only the far face of that edge, 10 cm behind it, and
-        // was taken as a contact that deep while it lay 1 cm outside b.
-        if p.check_claimed_depth
-            && outside > p.tie_distance
-            && -top > DEPTH_RATIO * outside + p.tie_distance
-        {
-            continue;
-        }
         out.extend(choose_face(
             (ia, vi, pv),
             ib,
             passing,
-            top,
             p.tie_distance,
             known,
         ));
@@ -192,13 +181,12 @@ fn vertex_face(
 }
 
 /// The candidate of vertex `vi` (at `xa`) of block `ia` among the faces of block `ib` it passed
-/// the tests with: the largest gap (`top`) wins; among faces tied with it, a known contact's face, else
+/// the tests with: the largest gap wins; among faces tied with it, a known contact's face, else
 /// the first.
 fn choose_face(
     (ia, vi, xa): (usize, usize, Vec3),
     ib: usize,
     mut passing: Vec<Alternative>,
-    top: f64,
     tie: f64,
     known: &dyn Fn(&ContactKey) -> bool,
 ) -> Option<Candidate> {
@@ -209,6 +197,10 @@ fn choose_face(
         feature_i: vi as u32,
         feature_j: face,
     };
+    let top = passing
+        .iter()
+        .map(|f| f.gap)
+        .fold(f64::NEG_INFINITY, f64::max);
     let largest = passing.iter().position(|f| f.gap == top)?;
     let chosen = passing
         .iter()
@@ -343,7 +335,7 @@ fn edge_edge(
                 continue;
             }
             let near_end = s.min(1.0 - s).min(t.min(1.0 - t)) < NEAR_END;
-            if p.check_claimed_depth
+            if p.check_crossing_depth
                 && near_end
                 && gap < 0.0
                 && !crossing_is_overlap(a, b, &xa, &xb, gap, p.tie_distance)
@@ -550,21 +542,6 @@ mod tests {
         assert!(gap < -0.03 && gap > -params().max_penetration, "{gap}");
         let c = detect_pair(0, &shape(&blade), 1, &shape(&tip), &params(), &|_| false);
         assert!(c.iter().all(|k| (k.xa - p).norm() > 1e-9), "{c:#?}");
-        // 3 mm below the base, within the slack, p is still outside b: the slope would claim
-        // it 1.8 cm deep, six times its distance outside, and DDA-3a's check refuses it.
-        let near = Vec3::new(p.x, p.y, -0.003);
-        let tip = tip_at(near);
-        let claims = |check_claimed_depth| {
-            let dp = DetectionParams {
-                check_claimed_depth,
-                ..params()
-            };
-            detect_pair(0, &shape(&blade), 1, &shape(&tip), &dp, &|_| false)
-                .iter()
-                .any(|k| (k.xa - near).norm() < 1e-9)
-        };
-        assert!(!claims(true));
-        assert!(claims(false), "the check, not another test, refuses it");
         // Moved up by 2.5 cm, p is inside b, 5 mm from the base: a contact 7.5 mm deep.
         let q = p + Vec3::z() * 0.025;
         let tip = tip_at(q);

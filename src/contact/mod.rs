@@ -78,13 +78,12 @@ pub struct DetectionParams {
     /// Faces whose gaps to a vertex differ by less than this are tied: the vertex sits on their
     /// common edge (see [`Candidate::tied`]).
     pub tie_distance: f64,
-    /// A contact must not claim a depth far beyond how deep its point lies inside the other
-    /// block: edges crossed near an end (see `detection::crossing_is_overlap`), and a vertex
-    /// just outside the other block whose passing face is a far one (see
-    /// `detection::vertex_face`). DDA-3a only: under DDA-3p's fixed penalty a contact sinks
-    /// N/p_n, centimetres at an impact, and the check then dropped corner crossings that held
-    /// the rockfall's column, whose kept overlaps grew from 3 mm to 4.5 cm.
-    pub check_claimed_depth: bool,
+    /// Edges crossed near an end must not cross much deeper than their points lie inside the
+    /// other block (see `detection::crossing_is_overlap`). DDA-3a only: under DDA-3p's fixed
+    /// penalty a contact sinks N/p_n, centimetres at an impact, and the check then dropped
+    /// corner crossings that held the rockfall's column, whose kept overlaps grew from 3 mm to
+    /// 4.5 cm.
+    pub check_crossing_depth: bool,
 }
 
 impl DetectionParams {
@@ -101,7 +100,7 @@ impl DetectionParams {
             edge_margin: 1e-3,
             merge_distance: 1e-3 * ds,
             tie_distance: 1e-3 * ds,
-            check_claimed_depth: true,
+            check_crossing_depth: true,
         }
     }
 }

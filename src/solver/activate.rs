@@ -49,7 +49,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let mut cands: Vec<Candidate> = Vec::new();
     for &(a, b) in &groups.pairs {
         let dp = DetectionParams {
-            check_claimed_depth: p.method == Method::Alm,
+            check_crossing_depth: p.method == Method::Alm,
             ..DetectionParams::new(groups.pair_w0(a, b), p.max_displacement_ratio)
         };
         cands.extend(detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known));
