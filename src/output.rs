@@ -6,7 +6,9 @@
 //! the kill landed inside a write, and then only its last line lacks its newline (a reader
 //! drops such a line). A failed write (a full disk) is cut back to the last whole step.
 //! `summary.json` is replaced atomically (written beside it, then renamed), so it is always
-//! one whole JSON document.
+//! one whole JSON document. [`vtk`] writes the ParaView series.
+
+pub mod vtk;
 
 use std::fs::File;
 use std::io::{self, Seek, SeekFrom, Write};
@@ -31,7 +33,7 @@ pub struct OutputError {
 }
 
 impl OutputError {
-    fn io(path: &Path, what: &str, e: impl std::fmt::Display) -> OutputError {
+    pub(crate) fn io(path: &Path, what: &str, e: impl std::fmt::Display) -> OutputError {
         OutputError {
             path: path.to_path_buf(),
             message: format!("{what}: {e}"),
@@ -123,7 +125,7 @@ pub struct RunWriter {
 
 /// Shortest round-trip text of a number, in exponent form when it is tiny (penetrations of
 /// 1e-16 m would otherwise print as thirty zeros).
-fn num(x: f64) -> String {
+pub(crate) fn num(x: f64) -> String {
     if x != 0.0 && x.abs() < 1e-4 {
         format!("{x:e}")
     } else {

@@ -69,6 +69,10 @@ pub struct BlockSnapshot {
     /// The rock mass the block was cut from (an index of [`Snapshot::rock_masses`]) and the
     /// region of its domain; `None` for a hand-made block.
     pub rock_mass: Option<(u16, u16)>,
+    /// Stress σx, σy, σz, τxy, τyz, τzx, Pa (tension positive).
+    pub stress: [f64; 6],
+    /// Volume, m³, as the solver holds it.
+    pub volume: f64,
 }
 
 #[cfg(test)]
@@ -101,6 +105,8 @@ impl BlockSnapshot {
             velocity: [0.0; 3],
             displacement: [0.0; 3],
             rock_mass: None,
+            stress: [0.0; 6],
+            volume: size * size * size,
         }
     }
 }
@@ -122,6 +128,9 @@ pub struct ContactSnapshot {
     pub normal_force: f64,
     /// Magnitude of the tangential (shear) force, N.
     pub shear_force: f64,
+    /// The tangential force on block i, N: the shear spring's pull of a locked contact, the
+    /// friction against the slip of a sliding one (its length is `shear_force`).
+    pub shear: [f64; 3],
     /// Penetration, m, positive when the blocks overlap.
     pub penetration: f64,
     /// Normal penalty in effect, N/m.

@@ -41,6 +41,8 @@ fn rock(name: &str, c: DVec3, a: f64, rot: DMat3, v: DVec3) -> BlockSnapshot {
         velocity: v.to_array(),
         displacement: (v * 0.3).to_array(),
         rock_mass: None,
+        stress: [0.0; 6],
+        volume: 1.0,
     }
 }
 
@@ -73,6 +75,7 @@ fn rockfall() -> Snapshot {
                 normal: slope_normal().to_array(),
                 normal_force: 3000.0 + 1500.0 * k as f64,
                 shear_force: 100.0,
+                shear: [100.0, 0.0, 0.0],
                 penetration: 0.0,
                 penalty: 0.0,
                 lambda: 0.0,

@@ -11,9 +11,12 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::exit::{self, Failure, Signal};
 use super::{CliError, SolverOverrides, load_scene};
+use crate::output::vtk::VtkWriter;
 use crate::output::{OutputError, RunWriter, Summary, slug};
 use crate::params::{Method, Mode};
 use crate::rockmass::report::RockMassReport;
+use crate::scene::OutputSettings;
+use crate::snapshot::Snapshot;
 use crate::solver::{Solver, SolverError};
 use crate::text::short;
 
@@ -29,6 +32,14 @@ pub struct RunArgs {
     /// No progress bar and no final line.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Also write the ParaView series into OUT/vtk/ (blocks as polyhedra, contacts as points,
+    /// .pvd collections with simulated time); the scene's `[output] vtk = true`
+    #[arg(long)]
+    pub vtk: bool,
+    /// Simulated time between VTK outputs, s (the scene's `[output] interval`; default: every
+    /// step). The first step at or past each multiple is written, and the final state
+    #[arg(long, value_name = "T")]
+    pub output_interval: Option<f64>,
 }
 
 /// A progress bar that appears only once a run has taken more than a second.
@@ -122,6 +133,8 @@ enum End {
 /// files committed to the same step and summary.json rewritten as "running".
 struct Record<'a> {
     writer: RunWriter,
+    /// The ParaView series, if asked for.
+    vtk: Option<VtkWriter>,
     scene: &'a str,
     method: Method,
     mode: Mode,
@@ -144,11 +157,20 @@ impl Record<'_> {
 
     /// Rows of the step just completed, and a checkpoint when one is due.
     fn step(&mut self, solver: &Solver) -> Result<(), OutputError> {
-        self.writer.write(&solver.snapshot())?;
+        self.write(&solver.snapshot())?;
         if self.last_checkpoint.elapsed() >= CHECKPOINT {
             self.checkpoint(solver)?;
         }
         Ok(())
+    }
+
+    /// The rows of a state, and its VTK files when an output is due.
+    fn write(&mut self, s: &Snapshot) -> Result<(), OutputError> {
+        self.writer.write(s)?;
+        match &mut self.vtk {
+            Some(vtk) => vtk.step(s),
+            None => Ok(()),
+        }
     }
 
     fn checkpoint(&mut self, solver: &Solver) -> Result<(), OutputError> {
@@ -184,7 +206,7 @@ fn advance(solver: &mut Solver, rec: &mut Record, args: &RunArgs) -> End {
             return Ok(End::Interrupted(signal));
         }
         // A failed equilibrium stage still writes the state it reached, as a diverged step does.
-        rec.writer.write(&solver.snapshot())?;
+        rec.write(&solver.snapshot())?;
         if let Err(e) = settled {
             return Ok(End::Diverged(e));
         }
@@ -212,11 +234,21 @@ pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)));
+    let interval = args.output_interval.or(scene.output.interval);
+    if let Some(dt) = args.output_interval {
+        OutputSettings::check_interval(dt)
+            .map_err(|m| Failure::Input(format!("--output-interval: {m}")))?;
+    }
     exit::catch_stop_signals()?;
     let writer = RunWriter::create(&out).map_err(|e| Failure::Io(e.to_string()))?;
+    let vtk = (args.vtk || scene.output.vtk)
+        .then(|| VtkWriter::create(&out, interval))
+        .transpose()
+        .map_err(|e| Failure::Io(e.to_string()))?;
     let name = scene.name.clone();
     let mut rec = Record {
         writer,
+        vtk,
         scene: &name,
         rock_masses: scene.rock_masses.clone(),
         method: scene.params.method,
@@ -227,9 +259,10 @@ pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
     let mut solver = Solver::new(scene.model, scene.params);
     let mut end = advance(&mut solver, &mut rec, args);
     if !matches!(end, End::Io(_)) {
-        // The last rows. If they cannot be written, that is what the summary reports: the
-        // files stop short of the state the run reached.
-        if let Err(e) = rec.writer.commit() {
+        // The last rows (and VTK files). If they cannot be written, that is what the summary
+        // reports: the files stop short of the state the run reached.
+        let last = rec.vtk.as_mut().map(|v| v.finish(&solver.snapshot()));
+        if let Err(e) = rec.writer.commit().and(last.unwrap_or(Ok(()))) {
             end = End::Io(e);
         }
     }

@@ -495,6 +495,8 @@ mod tests {
             velocity: [0.0, 0.0, -2.0],
             displacement: [0.0, 0.0, -0.5],
             rock_mass: None,
+            stress: [0.0; 6],
+            volume: 1.0,
             ..BlockSnapshot::test_cube(name, at, 1.0)
         }
     }
@@ -526,6 +528,7 @@ mod tests {
             normal: [0.0, 0.0, 1.0],
             normal_force: f,
             shear_force: 0.0,
+            shear: [0.0; 3],
             penetration: 0.0,
             penalty: 0.0,
             lambda: 0.0,

@@ -31,6 +31,20 @@ pub(super) struct SceneFile {
     /// writes for the sets of a rock mass it has cut.
     #[serde(default)]
     pub(super) joint_sets: Vec<Spanned<PlanesSpec>>,
+    /// What `dda3d run` writes besides the CSV files.
+    #[serde(default, deserialize_with = "table")]
+    pub(super) output: OutputSpec,
+}
+
+/// `[output]`: the ParaView series (`crate::output::vtk`).
+#[derive(Deserialize, Default, Clone, Copy)]
+#[serde(deny_unknown_fields)]
+pub(super) struct OutputSpec {
+    /// Write `DIR/vtk/` as `run --vtk` does.
+    #[serde(default)]
+    pub(super) vtk: bool,
+    /// Simulated time between VTK outputs, s (default: every step).
+    pub(super) interval: Option<f64>,
 }
 
 /// Reads a field that must be a table. serde lets a struct be read from a list of its fields in

@@ -108,6 +108,31 @@ pub struct Scene {
     pub model: Model,
     /// What cutting each `[[rock_masses]]` entry gave.
     pub rock_masses: Vec<RockMassReport>,
+    /// The scene's `[output]` table.
+    pub output: OutputSettings,
+}
+
+/// What `dda3d run` writes besides the CSV files (the scene's `[output]`; `run --vtk` and
+/// `--output-interval` override it).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct OutputSettings {
+    /// Write the ParaView series into `DIR/vtk/`.
+    pub vtk: bool,
+    /// Simulated time between VTK outputs, s (`None`: every step).
+    pub interval: Option<f64>,
+}
+
+impl OutputSettings {
+    /// A one-line problem with an output interval, if it has one.
+    pub fn check_interval(interval: f64) -> Result<(), String> {
+        if interval.is_finite() && interval > 0.0 {
+            Ok(())
+        } else {
+            Err(format!(
+                "output interval {interval} s: must be a positive number of seconds"
+            ))
+        }
+    }
 }
 
 /// Reads and validates a scene file.
@@ -242,6 +267,10 @@ fn parse_cut(
     params
         .check()
         .map_err(|e| err(first_key_line(text, e.keys), e.message))?;
+    if let Some(dt) = file.output.interval {
+        OutputSettings::check_interval(dt)
+            .map_err(|m| err(key_line(text, &["output", "interval"]), m))?;
+    }
 
     for (name, m) in &file.materials {
         check_material(name, m.get_ref()).map_err(|(key, e)| {
@@ -324,6 +353,10 @@ fn parse_cut(
             rock_masses: masses.names,
         },
         rock_masses: reports,
+        output: OutputSettings {
+            vtk: file.output.vtk,
+            interval: file.output.interval,
+        },
     };
     let cut = CutOutput {
         points: cut_points,

@@ -41,19 +41,27 @@ pub(crate) fn commit_contacts(
         let mut rec = c.rec;
         let closed = rec.state.is_closed();
         rec.penetration = c.dn + rec.overlap;
+        // The tangential force on block i: the spring pulls a locked contact back toward its
+        // reference, friction acts against a sliding one's slip τ.
+        let mut shear = Vec3::zeros();
         if closed {
             rec.normal_force = c.force;
-            rec.shear_force = match rec.state {
-                ContactState::Lock => p.contact.shear_penalty(rec.penalty) * c.shear.norm(),
+            let (magnitude, direction) = match rec.state {
+                ContactState::Lock => (
+                    p.contact.shear_penalty(rec.penalty) * c.shear.norm(),
+                    -c.shear.try_normalize(0.0).unwrap_or_else(Vec3::zeros),
+                ),
                 _ => {
                     let n_prev = if p.method == Method::Alm {
                         rec.lambda
                     } else {
                         rec.normal_force.max(0.0)
                     };
-                    n_prev * c.tan_phi(p)
+                    (n_prev * c.tan_phi(p), -rec.tau)
                 }
             };
+            rec.shear_force = magnitude;
+            shear = direction * magnitude;
         } else {
             rec.normal_force = 0.0;
             rec.shear_force = 0.0;
@@ -71,6 +79,7 @@ pub(crate) fn commit_contacts(
                 normal: (mj.rotation() * c.cand.normal).into(),
                 normal_force: rec.normal_force,
                 shear_force: rec.shear_force,
+                shear: (mj.rotation() * shear).into(),
                 penetration: c.dn + rec.overlap,
                 penalty: rec.penalty,
                 joint: c.joint,

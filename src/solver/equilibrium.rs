@@ -266,6 +266,7 @@ mod tests {
             normal: [0.0, 0.0, 1.0],
             normal_force: 3.0 * b.mass * 9.8,
             shear_force: 4.0 * b.mass * 9.8,
+            shear: [4.0 * b.mass * 9.8, 0.0, 0.0],
             penetration: 0.0,
             penalty: 1.0,
             lambda: 0.0,

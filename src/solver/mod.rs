@@ -477,6 +477,8 @@ impl Solver {
                     velocity: [b.velocity[0], b.velocity[1], b.velocity[2]],
                     displacement: (b.mp.centroid - b.initial_centroid).into(),
                     rock_mass: b.rock_mass.map(|r| (r.mass, r.region)),
+                    stress: b.stress.into(),
+                    volume: b.mp.volume,
                 })
                 .collect(),
             contacts: self.contacts.clone(),

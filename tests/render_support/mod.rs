@@ -95,6 +95,8 @@ pub fn slope_block() -> BlockSnapshot {
         velocity: [0.0; 3],
         displacement: [0.0; 3],
         rock_mass: None,
+        stress: [0.0; 6],
+        volume: 1.0,
     }
 }
 
@@ -128,6 +130,8 @@ pub fn box_block(s: f64) -> BlockSnapshot {
         velocity: [0.0; 3],
         displacement: [0.0; 3],
         rock_mass: None,
+        stress: [0.0; 6],
+        volume: 1.0,
     }
 }
 
@@ -148,6 +152,7 @@ pub fn slope_snapshot(t: f64, step: u64, s: f64, state: ContactState) -> Snapsho
             normal: n,
             normal_force: forces[k],
             shear_force: 0.5 * forces[k],
+            shear: [0.5 * forces[k], 0.0, 0.0],
             penetration: 1e-5,
             penalty: 1e9,
             lambda: forces[k],
