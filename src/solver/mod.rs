@@ -16,6 +16,7 @@ mod active;
 mod alm;
 mod assemble;
 mod attempt;
+pub mod checkpoint;
 mod commit;
 mod counters;
 mod equilibrium;
