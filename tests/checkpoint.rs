@@ -119,22 +119,22 @@ fn resumed_run_matches(name: &str, scene: &Path, flags: &[&str], duration: &str,
 
 #[test]
 fn rockfall_resumed_with_alm_writes_the_same_rows() {
-    resumed_run_matches("alm", &rockfall(), &["--method", "alm"], "0.6", "0.25");
+    resumed_run_matches("alm", &rockfall(), &["--method", "alm"], "2.0", "0.5");
 }
 
 #[test]
 fn rockfall_resumed_with_penalty_writes_the_same_rows() {
-    resumed_run_matches("penalty", &rockfall(), &["--method", "penalty"], "0.6", "0.25");
+    resumed_run_matches("penalty", &rockfall(), &["--method", "penalty"], "2.0", "0.5");
 }
 
-/// A wall of 20 blocks (4 columns of 5) struck by the rock, as tests/rockfall.rs builds its wall:
-/// the resume falls in the impact, with many contacts and their records alive.
+/// A wall of 40 blocks (8 columns of 5) struck by the rock, as tests/rockfall.rs builds its wall
+/// of 80: the resume falls in the impact (at 0.3 s), with many contacts and their records alive.
 #[test]
 fn struck_wall_resumed_writes_the_same_rows() {
     let dir = fresh_dir("wall_scene");
     let scene = dir.join("wall.toml");
-    std::fs::write(&scene, dda3d::generate::column_wall(20, 5, true)).unwrap();
-    resumed_run_matches("wall", &scene, &[], "0.5", "0.2");
+    std::fs::write(&scene, dda3d::generate::column_wall(40, 5, true)).unwrap();
+    resumed_run_matches("wall", &scene, &[], "0.8", "0.3");
 }
 
 /// A run resumed with a later --duration goes on past the end of the run it continues, from the
