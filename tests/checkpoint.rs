@@ -100,7 +100,10 @@ fn resumed_run_matches(name: &str, scene: &Path, flags: &[&str], duration: &str,
         );
     }
     let contacts_after = read(&resumed, "contacts.csv").lines().count() - 1;
-    assert!(contacts_after > 0, "{name}: no contacts after t1 to compare");
+    assert!(
+        contacts_after > 0,
+        "{name}: no contacts after t1 to compare"
+    );
     let later: Vec<_> = checkpoints(&resumed);
     assert_eq!(later.len(), saved.len() - 1, "{name}: {later:?}");
     for (a, b) in saved[1..].iter().zip(&later) {
@@ -124,7 +127,13 @@ fn rockfall_resumed_with_alm_writes_the_same_rows() {
 
 #[test]
 fn rockfall_resumed_with_penalty_writes_the_same_rows() {
-    resumed_run_matches("penalty", &rockfall(), &["--method", "penalty"], "2.0", "0.5");
+    resumed_run_matches(
+        "penalty",
+        &rockfall(),
+        &["--method", "penalty"],
+        "2.0",
+        "0.5",
+    );
 }
 
 /// A wall of 40 blocks (8 columns of 5) struck by the rock, as tests/rockfall.rs builds its wall
@@ -197,7 +206,10 @@ fn expect_refused(file: &Path, problem: &str) {
     );
     assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
     assert!(err.starts_with("error: "), "{err}");
-    assert!(err.contains(&file.display().to_string()), "names the file: {err}");
+    assert!(
+        err.contains(&file.display().to_string()),
+        "names the file: {err}"
+    );
     assert!(err.contains(problem), "says '{problem}': {err}");
     assert!(!err.contains("panicked"), "{err}");
     assert!(!out.exists(), "nothing written for bad input");
@@ -218,7 +230,10 @@ fn bad_checkpoints_exit_2_with_one_line() {
         p
     };
 
-    expect_refused(&write("truncated.ckpt", &good[..good.len() / 3]), "truncated");
+    expect_refused(
+        &write("truncated.ckpt", &good[..good.len() / 3]),
+        "truncated",
+    );
     expect_refused(&write("header_only.ckpt", &good[..20]), "truncated");
     let mut corrupt = good.clone();
     let mid = corrupt.len() / 2;
@@ -235,16 +250,33 @@ fn bad_checkpoints_exit_2_with_one_line() {
 #[test]
 fn usage_errors_exit_2() {
     let dir = fresh_dir("usage");
-    let status = |o: Output| (o.status.code(), String::from_utf8_lossy(&o.stderr).to_string());
+    let status = |o: Output| {
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).to_string(),
+        )
+    };
     let bad = Some(i32::from(Status::BadInput.code()));
     let out = dir.join("out");
     // A scene and a checkpoint, or a solver setting with a checkpoint (it has its own).
     let ckpt = dir.join("x.ckpt");
     for (args, paths) in [
-        (vec![], vec![("", rockfall().as_path()), ("--resume", &ckpt)]),
-        (vec!["--method", "penalty"], vec![("--resume", ckpt.as_path())]),
-        (vec!["--checkpoint-every", "0"], vec![("", rockfall().as_path())]),
-        (vec!["--checkpoint-every", "-1"], vec![("", rockfall().as_path())]),
+        (
+            vec![],
+            vec![("", rockfall().as_path()), ("--resume", &ckpt)],
+        ),
+        (
+            vec!["--method", "penalty"],
+            vec![("--resume", ckpt.as_path())],
+        ),
+        (
+            vec!["--checkpoint-every", "0"],
+            vec![("", rockfall().as_path())],
+        ),
+        (
+            vec!["--checkpoint-every", "-1"],
+            vec![("", rockfall().as_path())],
+        ),
         (vec![], vec![]),
     ] {
         let mut paths = paths.clone();

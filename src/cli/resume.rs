@@ -31,8 +31,8 @@ pub(super) fn interval(every: Option<f64>) -> Result<Option<f64>, Failure> {
 /// from t = 0, as a scene's `duration`). A file that is not a checkpoint of this version, or a
 /// duration that leaves nothing to run, is bad input.
 pub(super) fn resume(path: &Path, o: &SolverOverrides) -> Result<Solver, Failure> {
-    let mut solver = checkpoint::load(path)
-        .map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?;
+    let mut solver =
+        checkpoint::load(path).map_err(|e| Failure::Input(format!("{}: {e}", path.display())))?;
     if let Some(d) = o.duration {
         if !(d.is_finite() && d > 0.0) {
             return Err(Failure::Input(format!(

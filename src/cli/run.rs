@@ -276,7 +276,11 @@ fn start(args: &RunArgs) -> Result<(Solver, Vec<RockMassReport>, PathBuf), Failu
     }
     let scene = load_scene(args.source(), &args.overrides)?;
     let out = PathBuf::from("out").join(slug(&scene.name));
-    Ok((Solver::new(scene.model, scene.params), scene.rock_masses, out))
+    Ok((
+        Solver::new(scene.model, scene.params),
+        scene.rock_masses,
+        out,
+    ))
 }
 
 /// The outcome as one line on stderr (or none) and an exit status.

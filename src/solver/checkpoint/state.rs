@@ -23,8 +23,8 @@ use crate::contact::record::ContactRecord;
 use crate::model::{Block, JointFace, Model, RockMassOf};
 use crate::params::{ContactParams, JointParams, JointSetParams, Method, Mode, SolverParams};
 use crate::physics::geometry::{Edge, MassProperties, Topology, Vec3};
-use crate::physics::mechanics::{Material, Vec12, elasticity_matrix};
 use crate::physics::linear::{BlockMatrix, SparseCholesky};
+use crate::physics::mechanics::{Material, Vec12, elasticity_matrix};
 use crate::snapshot::{
     ContactSnapshot, ContactState, EquilibriumReport, RunTotals, StepStats, Timings,
 };
@@ -489,10 +489,7 @@ impl SavedBlock {
             mass: self.mass,
             density: 0.0,
             mass_matrix: Default::default(),
-            elasticity: elasticity_matrix(
-                self.material.young_modulus,
-                self.material.poisson_ratio,
-            ),
+            elasticity: elasticity_matrix(self.material.young_modulus, self.material.poisson_ratio),
             velocity: Vec12::from(self.velocity),
             acceleration: Vec12::from(self.acceleration),
             stress: self.stress.into(),
@@ -507,7 +504,9 @@ impl SavedBlock {
                 .into_iter()
                 .map(|j| j.map(|(set, plane)| JointFace { set, plane }))
                 .collect(),
-            rock_mass: self.rock_mass.map(|(mass, region)| RockMassOf { mass, region }),
+            rock_mass: self
+                .rock_mass
+                .map(|(mass, region)| RockMassOf { mass, region }),
         };
         b.refresh();
         Ok(b)
@@ -523,11 +522,16 @@ impl SavedBlock {
         }
         let vertex_ok = |v: &usize| *v < nv;
         if !self.faces.iter().flatten().all(vertex_ok)
-            || !self.edges.iter().all(|(v, f)| {
-                v.iter().all(vertex_ok) && f.iter().all(|f| *f < nf)
-            })
+            || !self
+                .edges
+                .iter()
+                .all(|(v, f)| v.iter().all(vertex_ok) && f.iter().all(|f| *f < nf))
             || self.vertex_edges.len() != nv
-            || !self.vertex_edges.iter().flatten().all(|e| *e < self.edges.len())
+            || !self
+                .vertex_edges
+                .iter()
+                .flatten()
+                .all(|e| *e < self.edges.len())
         {
             return bad("an index out of range");
         }

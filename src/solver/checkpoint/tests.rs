@@ -95,7 +95,15 @@ fn what_is_not_a_whole_checkpoint_is_refused() {
     let err = |b: &[u8]| decode(b).err().expect("refused");
     assert_eq!(err(b""), CheckpointError::Foreign);
     assert_eq!(err(b"[solver]\nduration = 1\n"), CheckpointError::Foreign);
-    for cut in [3, 16, 21, HEADER, HEADER + 1, bytes.len() / 2, bytes.len() - 1] {
+    for cut in [
+        3,
+        16,
+        21,
+        HEADER,
+        HEADER + 1,
+        bytes.len() / 2,
+        bytes.len() - 1,
+    ] {
         assert!(
             matches!(err(&bytes[..cut]), CheckpointError::Truncated { .. }),
             "cut at {cut}: {}",
@@ -104,10 +112,7 @@ fn what_is_not_a_whole_checkpoint_is_refused() {
     }
     let mut other = bytes.clone();
     other[16..20].copy_from_slice(&(VERSION + 1).to_le_bytes());
-    assert_eq!(
-        err(&other),
-        CheckpointError::Version { found: VERSION + 1 }
-    );
+    assert_eq!(err(&other), CheckpointError::Version { found: VERSION + 1 });
     for at in [HEADER, HEADER + 100, bytes.len() - 1] {
         let mut flipped = bytes.clone();
         flipped[at] ^= 0x10;
