@@ -294,35 +294,6 @@ impl SavedSolver {
     }
 }
 
-#[cfg(test)]
-impl SavedSolver {
-    /// Points a contact record at a block the model does not have.
-    pub(super) fn break_a_record_for_tests(&mut self) {
-        let key = ContactKey {
-            i: self.blocks.len() as u32,
-            j: 0,
-            mode: 0,
-            feature_i: 0,
-            feature_j: 0,
-        };
-        let record = SavedRecord::of(&ContactRecord {
-            state: ContactState::Open,
-            lambda: 0.0,
-            penalty: 0.0,
-            normal_force: 0.0,
-            shear_force: 0.0,
-            penetration: 0.0,
-            reference: Vec3::zeros(),
-            tau: Vec3::zeros(),
-            normal: Vec3::zeros(),
-            intact: false,
-            cohesion_area: 0.0,
-            overlap: 0.0,
-        });
-        self.records.push((key, record));
-    }
-}
-
 impl SavedParams {
     fn of(p: &SolverParams) -> Self {
         let SolverParams {
@@ -628,5 +599,34 @@ impl SavedStage {
             last_force: self.last_force,
             best: self.best,
         }
+    }
+}
+
+#[cfg(test)]
+impl SavedSolver {
+    /// Points a contact record at a block the model does not have.
+    pub(super) fn break_a_record_for_tests(&mut self) {
+        let key = ContactKey {
+            i: self.blocks.len() as u32,
+            j: 0,
+            mode: 0,
+            feature_i: 0,
+            feature_j: 0,
+        };
+        let record = SavedRecord::of(&ContactRecord {
+            state: ContactState::Open,
+            lambda: 0.0,
+            penalty: 0.0,
+            normal_force: 0.0,
+            shear_force: 0.0,
+            penetration: 0.0,
+            reference: Vec3::zeros(),
+            tau: Vec3::zeros(),
+            normal: Vec3::zeros(),
+            intact: false,
+            cohesion_area: 0.0,
+            overlap: 0.0,
+        });
+        self.records.push((key, record));
     }
 }
