@@ -107,6 +107,10 @@ impl Progress {
 /// unconverged stage is a warning (a block the stage could not bring to rest), not an error.
 /// A stop signal ends the stage early (`Ok(Some(signal))`).
 fn settle(solver: &mut Solver, scene: &Path, quiet: bool) -> Result<Option<Signal>, SolverError> {
+    // A run resumed after its stage said how the stage ended the first time.
+    if !solver.in_equilibrium_stage() && solver.time > 0.0 {
+        return Ok(None);
+    }
     while solver.in_equilibrium_stage() {
         if let Some(signal) = exit::interrupted() {
             return Ok(Some(signal));
