@@ -3,10 +3,11 @@
 //! Data flows one way: scene → solver → [`Snapshot`] → renderer / output files. Nothing in here
 //! refers back to the solver, so the renderer and the CSV writers depend only on this module.
 
-use serde::Serialize;
+// Deserialize too: a checkpoint (`crate::solver::checkpoint`) saves some of these as they are.
+use serde::{Deserialize, Serialize};
 
 /// How a contact was entered (paper Fig. 1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum ContactMode {
     /// A vertex of block i against a face of block j.
     VertexFace,
@@ -25,7 +26,7 @@ impl ContactMode {
 }
 
 /// Mohr–Coulomb state of a contact (reference §6.1).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum ContactState {
     Open,
     /// Closed, tangentially held by the shear spring.
@@ -112,7 +113,7 @@ impl BlockSnapshot {
 }
 
 /// One active (non-open) contact at the end of a step.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ContactSnapshot {
     /// Index of the block that owns the vertex (V–F) or the first edge (E–E).
     pub block_i: usize,
@@ -143,7 +144,7 @@ pub struct ContactSnapshot {
 }
 
 /// Per-step statistics.
-#[derive(Clone, Debug, Default, Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct StepStats {
     /// Length of the accepted step, s.
     pub time_step: f64,
@@ -178,7 +179,7 @@ pub struct StepStats {
 }
 
 /// The initial equilibrium stage (`[solver] initial_equilibrium`), while it runs and after.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EquilibriumReport {
     /// Static steps taken.
     pub steps: u64,
@@ -215,7 +216,7 @@ pub struct Snapshot {
 }
 
 /// Wall time spent in the phases of the solver.
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Timings {
     pub detection: f64,
     pub assembly: f64,
@@ -225,7 +226,7 @@ pub struct Timings {
 }
 
 /// Totals over a run, for `summary.json` and the benchmark.
-#[derive(Clone, Debug, Default, serde::Serialize)]
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct RunTotals {
     pub steps: u64,
     pub open_close_iterations: u64,

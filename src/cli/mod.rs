@@ -13,6 +13,7 @@ mod cut;
 pub mod exit;
 mod generate;
 mod render;
+mod resume;
 mod run;
 mod view;
 

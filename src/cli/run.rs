@@ -1,7 +1,8 @@
 //! `dda3d run`: simulates a scene headless and writes blocks.csv, contacts.csv and summary.json,
 //! with a progress bar for long runs (also used by `dda3d render`). A run stopped by SIGINT or
 //! SIGTERM finishes its step and writes everything; a checkpoint every second keeps the files
-//! usable even after a kill -9 (see [`crate::output`]).
+//! usable even after a kill -9 (see [`crate::output`]). `--checkpoint-every` saves the solver's
+//! whole state as the run goes, and `--resume` goes on from such a file (see [`super::resume`]).
 
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -10,6 +11,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::exit::{self, Failure, Signal};
+use super::resume::{self, Checkpoints};
 use super::{CliError, SolverOverrides, load_scene};
 use crate::output::vtk::VtkWriter;
 use crate::output::{OutputError, RunWriter, Summary, slug};
@@ -22,8 +24,9 @@ use crate::text::short;
 
 #[derive(Args, Debug)]
 pub struct RunArgs {
-    /// Scene file (TOML).
-    pub scene: PathBuf,
+    /// Scene file (TOML). Left out with --resume, whose checkpoint holds the scene.
+    #[arg(required_unless_present = "resume")]
+    pub scene: Option<PathBuf>,
     #[command(flatten)]
     pub overrides: SolverOverrides,
     /// Output directory (default: out/<scene name as a slug>).
@@ -32,6 +35,22 @@ pub struct RunArgs {
     /// No progress bar and no final line.
     #[arg(long, short)]
     pub quiet: bool,
+    /// Save the solver's complete state to OUT/checkpoint_<t>.ckpt at the end of the first step
+    /// at or after each multiple of T seconds of simulated time (t: that step's time, to the
+    /// microsecond). Saving does not change the run.
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    pub checkpoint_every: Option<f64>,
+    /// Go on with the run saved in CHECKPOINT (a checkpoint_<t>.ckpt file), in place of SCENE:
+    /// from t on it writes the rows the uninterrupted run wrote, byte for byte, starting with
+    /// the row at t. The solver settings are the checkpoint's; --duration is the new end time
+    /// (total simulated time from t = 0, as in the scene); --out defaults to
+    /// out/<scene name>-resumed, so the run it continues is kept.
+    #[arg(
+        long,
+        value_name = "CHECKPOINT",
+        conflicts_with_all = ["scene", "method", "mode", "spectral_radius", "max_time_step", "initial_equilibrium"]
+    )]
+    pub resume: Option<PathBuf>,
     /// Also write the ParaView series into OUT/vtk/ (blocks as polyhedra, contacts as points,
     /// .pvd collections with simulated time); the scene's `[output] vtk = true`
     #[arg(long)]
@@ -40,6 +59,14 @@ pub struct RunArgs {
     /// step). The first step at or past each multiple is written, and the final state
     #[arg(long, value_name = "T")]
     pub output_interval: Option<f64>,
+}
+
+impl RunArgs {
+    /// The file the run comes from, for messages: the scene, or the checkpoint resumed.
+    fn source(&self) -> &Path {
+        let from = self.resume.as_deref().or(self.scene.as_deref());
+        from.unwrap_or(Path::new("-"))
+    }
 }
 
 /// A progress bar that appears only once a run has taken more than a second.
@@ -91,6 +118,10 @@ impl Progress {
 /// unconverged stage is a warning (a block the stage could not bring to rest), not an error.
 /// A stop signal ends the stage early (`Ok(Some(signal))`).
 fn settle(solver: &mut Solver, scene: &Path, quiet: bool) -> Result<Option<Signal>, SolverError> {
+    // A run resumed after its stage said how the stage ended the first time.
+    if !solver.in_equilibrium_stage() && solver.time > 0.0 {
+        return Ok(None);
+    }
     while solver.in_equilibrium_stage() {
         if let Some(signal) = exit::interrupted() {
             return Ok(Some(signal));
@@ -141,6 +172,8 @@ struct Record<'a> {
     start: Instant,
     last_checkpoint: Instant,
     rock_masses: Vec<RockMassReport>,
+    /// The solver's state saved every `--checkpoint-every`.
+    states: Checkpoints,
 }
 
 impl Record<'_> {
@@ -158,6 +191,7 @@ impl Record<'_> {
     /// Rows of the step just completed, and a checkpoint when one is due.
     fn step(&mut self, solver: &Solver) -> Result<(), OutputError> {
         self.write(&solver.snapshot())?;
+        self.states.after_step(solver, self.writer.dir())?;
         if self.last_checkpoint.elapsed() >= CHECKPOINT {
             self.checkpoint(solver)?;
         }
@@ -201,7 +235,7 @@ fn advance(solver: &mut Solver, rec: &mut Record, args: &RunArgs) -> End {
     let end = (|| {
         // A first summary.json at once, so even a run killed in its first second says so.
         rec.checkpoint(solver)?;
-        let settled = settle(solver, &args.scene, args.quiet);
+        let settled = settle(solver, args.source(), args.quiet);
         if let Ok(Some(signal)) = settled {
             return Ok(End::Interrupted(signal));
         }
@@ -229,34 +263,32 @@ fn advance(solver: &mut Solver, rec: &mut Record, args: &RunArgs) -> End {
 /// `dda3d run`, with its failures as [`Failure`]s (their exit statuses). Bad input is
 /// reported before any file is created.
 pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
-    let scene = load_scene(&args.scene, &args.overrides)?;
-    let out = args
-        .out
-        .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)));
-    let interval = args.output_interval.or(scene.output.interval);
+    let every = resume::interval(args.checkpoint_every)?;
     if let Some(dt) = args.output_interval {
         OutputSettings::check_interval(dt)
             .map_err(|m| Failure::Input(format!("--output-interval: {m}")))?;
     }
+    let (mut solver, rock_masses, output, default_out) = start(args)?;
+    let out = args.out.clone().unwrap_or(default_out);
     exit::catch_stop_signals()?;
     let writer = RunWriter::create(&out).map_err(|e| Failure::Io(e.to_string()))?;
-    let vtk = (args.vtk || scene.output.vtk)
+    let interval = args.output_interval.or(output.interval);
+    let vtk = (args.vtk || output.vtk)
         .then(|| VtkWriter::create(&out, interval))
         .transpose()
         .map_err(|e| Failure::Io(e.to_string()))?;
-    let name = scene.name.clone();
+    let name = solver.model.name.clone();
     let mut rec = Record {
         writer,
         vtk,
         scene: &name,
-        rock_masses: scene.rock_masses.clone(),
-        method: scene.params.method,
-        mode: scene.params.mode,
+        rock_masses,
+        method: solver.params.method,
+        mode: solver.params.mode,
         start: Instant::now(),
         last_checkpoint: Instant::now(),
+        states: Checkpoints::new(every, solver.time),
     };
-    let mut solver = Solver::new(scene.model, scene.params);
     let mut end = advance(&mut solver, &mut rec, args);
     if !matches!(end, End::Io(_)) {
         // The last rows (and VTK files). If they cannot be written, that is what the summary
@@ -268,6 +300,28 @@ pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
     }
     let saved = rec.finish(&solver, &end);
     report(&solver, &rec, end, saved, args)
+}
+
+/// What a run starts from: the solver (the scene's, or the checkpoint's), the rock masses cut
+/// for summary.json (a resumed run has none: the cut was the first run's), the scene's
+/// `[output]` table (a resumed run writes VTK only with `--vtk`), and the default output
+/// directory.
+type Start = (Solver, Vec<RockMassReport>, OutputSettings, PathBuf);
+
+fn start(args: &RunArgs) -> Result<Start, Failure> {
+    if let Some(path) = &args.resume {
+        let solver = resume::resume(path, &args.overrides)?;
+        let out = resume::default_out(&solver);
+        return Ok((solver, Vec::new(), OutputSettings::default(), out));
+    }
+    let scene = load_scene(args.source(), &args.overrides)?;
+    let out = PathBuf::from("out").join(slug(&scene.name));
+    Ok((
+        Solver::new(scene.model, scene.params),
+        scene.rock_masses,
+        scene.output,
+        out,
+    ))
 }
 
 /// The outcome as one line on stderr (or none) and an exit status.
@@ -291,7 +345,7 @@ fn report(
         (_, Err(e)) => Err(Failure::Io(format!("{e}; {kept}"))),
         (End::Diverged(e), Ok(())) => Err(Failure::Diverged(format!(
             "{}: {e}; results up to t = {} s are in {out}",
-            args.scene.display(),
+            args.source().display(),
             short(solver.time)
         ))),
         (End::Interrupted(signal), Ok(())) => Err(Failure::Interrupted(

@@ -22,7 +22,9 @@ use crate::physics::geometry::{Topology, Vec3};
 pub use crate::snapshot::{ContactMode, ContactState};
 
 /// Identity of a contact across steps: the blocks and the features that touch.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
 pub struct ContactKey {
     /// Block owning the vertex (V–F) or the first edge (E–E).
     pub i: u32,

@@ -259,6 +259,21 @@ impl SparseCholesky {
         Ok(())
     }
 
+    /// Whether a symbolic analysis is kept (for the next factorization to reuse).
+    pub fn analysed(&self) -> bool {
+        self.symbolic.is_some()
+    }
+
+    /// Performs `k`'s symbolic analysis now, uncounted: a solver restored from a checkpoint
+    /// (which does not save the factorization) starts with the analysis the uninterrupted run
+    /// kept, and so counts its analyses as that run does.
+    pub fn analyse_ahead(&mut self, k: &BlockMatrix) -> Result<(), SolveError> {
+        let count = self.symbolic_count;
+        self.ensure_pattern(k)?;
+        self.symbolic_count = count;
+        Ok(())
+    }
+
     /// Numeric factorization of `k`.
     pub fn factorize(&mut self, k: &BlockMatrix) -> Result<(), SolveError> {
         self.ensure_pattern(k)?;

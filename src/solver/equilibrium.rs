@@ -50,7 +50,7 @@ const SLIDING_STEPS: u64 = 20;
 const PLATEAU_GAIN: f64 = 0.5;
 
 /// The two halves of the stage.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub(crate) enum Phase {
     /// Static steps, joints held against sliding: gravity loads the contacts with no overshoot.
     Locked,
@@ -73,19 +73,19 @@ impl Unbalance {
     }
 }
 
-/// A stage under way.
+/// A stage under way. Its fields are seen by [`super::checkpoint`], which saves them.
 pub(crate) struct Stage {
     /// Blocks held during the stage, with the velocity they start the run with.
-    held: Vec<(usize, Vec12)>,
+    pub(super) held: Vec<(usize, Vec12)>,
     pub report: EquilibriumReport,
     /// Which half of the stage is running.
     pub phase: Phase,
     /// Consecutive settling steps with the force ratio above [`SLIDING_RATIO`] and growing.
-    sliding: u64,
+    pub(super) sliding: u64,
     /// The force ratio of the last step.
-    last_force: f64,
+    pub(super) last_force: f64,
     /// The best R_max so far (to within [`PLATEAU_GAIN`]) and the step it was reached.
-    best: (f64, u64),
+    pub(super) best: (f64, u64),
 }
 
 impl Stage {

@@ -9,13 +9,15 @@
 //! 5. [`commit`]: the solution becomes the new state, and the contacts' records move on.
 //!
 //! [`counters`] times the stages and counts iterations for `summary.json`. What leaves the
-//! solver is plain data: [`Snapshot`], [`StepStats`] and [`RunTotals`].
+//! solver is plain data: [`Snapshot`], [`StepStats`] and [`RunTotals`]. [`checkpoint`] saves the
+//! whole solver to a file and restores it, for a run that goes on exactly where it stopped.
 
 mod activate;
 mod active;
 mod alm;
 mod assemble;
 mod attempt;
+pub mod checkpoint;
 mod commit;
 mod counters;
 mod equilibrium;

@@ -28,8 +28,9 @@ pub const STEP_GAIN_FLOOR: f64 = 1e-4;
 /// Below this scale, J, a model has nothing that moves it: round-off is not a gain.
 const ENERGY_FLOOR: f64 = 1e-6;
 
-/// The energy balance of a run since its start (or the end of the equilibrium stage).
-#[derive(Clone, Debug)]
+/// The energy balance of a run since its start (or the end of the equilibrium stage). Saved
+/// whole in a checkpoint ([`super::checkpoint`]).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct EnergyWatch {
     /// Kinetic, gravitational and elastic energy at the start, J.
     start: [f64; 3],
