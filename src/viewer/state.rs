@@ -237,6 +237,10 @@ pub struct UiState {
     pub show_plots: bool,
     /// "name (backend, type), N× MSAA".
     pub adapter: String,
+    /// Where Save state writes and Load state looks (the viewer's `--out`).
+    pub out_dir: std::path::PathBuf,
+    /// The command id of the last sim notice shown ([`Frame::notice`]).
+    last_notice: u64,
 }
 
 impl UiState {
@@ -266,6 +270,8 @@ impl UiState {
             perf: Perf::default(),
             show_plots: true,
             adapter,
+            out_dir: std::path::PathBuf::from("out"),
+            last_notice: 0,
         }
     }
 
@@ -283,6 +289,12 @@ impl UiState {
                 self.params.edit = f.params.clone();
                 self.params.last_sent = f.params.clone();
                 self.speed = f.speed;
+            }
+            if let Some((id, text)) = &f.notice
+                && *id > self.last_notice
+            {
+                self.last_notice = *id;
+                self.info(text.clone());
             }
             // A scene with rock masses opens coloured by rock mass (the user may change it).
             if self.frame.is_none()
@@ -463,6 +475,7 @@ pub(super) mod tests {
             state: RunState::Paused,
             speed: Speed::Max,
             error: None,
+            notice: None,
             steps_per_second: 0.0,
             seconds_per_step: 0.0,
             running_seconds: 0.0,

@@ -242,7 +242,8 @@ impl Viewer {
             .handle
             .latest()
             .ok_or_else(|| ViewerError::Failed("the simulation published no state".into()))?;
-        let ui = UiState::new(&opts.scene, &first.snapshot, adapter);
+        let mut ui = UiState::new(&opts.scene, &first.snapshot, adapter);
+        ui.out_dir = opts.out_dir.clone();
         Ok(Viewer {
             surface,
             gpu,

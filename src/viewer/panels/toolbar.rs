@@ -38,6 +38,8 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
             rates(ui, state, &frame);
             ui.separator();
             capture_buttons(ui, state, actions);
+            ui.separator();
+            state_buttons(ui, state, actions);
         });
     });
 }
@@ -180,6 +182,42 @@ fn rates(ui: &mut egui::Ui, state: &UiState, frame: &Frame) {
         seconds(frame.seconds_per_step),
         state.adapter
     ));
+}
+
+/// Save state and Load state (a menu of the checkpoints in the output directory, latest
+/// first), laid out right to left.
+fn state_buttons(ui: &mut egui::Ui, state: &UiState, actions: &mut Vec<Action>) {
+    let dir = &state.out_dir;
+    ui.menu_button("Load state", |ui| {
+        let files = crate::viewer::sim::states::list(dir);
+        if files.is_empty() {
+            ui.label(format!("no checkpoint_*.ckpt in {}", dir.display()));
+        }
+        for path in files {
+            let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
+            if ui.button(name.unwrap_or_default()).clicked() {
+                actions.push(Action::Sim(Command::LoadState(path)));
+                ui.close();
+            }
+        }
+    })
+    .response
+    .on_hover_text(format!(
+        "Replace the run with a saved state of this scene (paused): the checkpoints in {}, \
+         from Save state or `dda3d run --checkpoint-every`",
+        dir.display()
+    ));
+    if ui
+        .button("Save state")
+        .on_hover_text(format!(
+            "Write the solver's complete state to {}/checkpoint_<t>.ckpt: Load state \
+             reopens it, and `dda3d run --resume FILE` goes on with it headless",
+            dir.display()
+        ))
+        .clicked()
+    {
+        actions.push(Action::Sim(Command::SaveState(dir.clone())));
+    }
 }
 
 /// Record (or Stop) and Screenshot, laid out right to left.

@@ -22,6 +22,7 @@
 //! - this file: the window's end, [`SimHandle`], and the mailbox the two sides share.
 
 mod protocol;
+pub mod states;
 mod thread;
 
 use std::sync::mpsc::{self, Sender};
@@ -205,6 +206,49 @@ mod tests {
             .expect("keeps stepping with the new parameters");
         assert_eq!(later.params, p);
         assert!(later.error.is_none());
+    }
+
+    #[test]
+    fn a_saved_state_loads_back_paused_at_its_time_with_a_notice() {
+        let dir = std::env::temp_dir().join(format!("dda3d-sim-state-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let mut h = spawn(Speed::Max, false);
+        for _ in 0..3 {
+            let id = h.send(Command::Step);
+            h.wait_for(WAIT, |f| f.applied >= id && f.snapshot.step >= id)
+                .expect("steps");
+        }
+        let saved = h.latest().unwrap();
+        let id = h.send(Command::SaveState(dir.clone()));
+        let f = h.wait_for(WAIT, |f| f.applied >= id).unwrap();
+        let notice = f.notice.clone().expect("a notice");
+        assert_eq!(notice.0, id);
+        assert!(notice.1.contains("state saved"), "{notice:?}");
+        let id = h.send(Command::Play);
+        h.wait_for(WAIT, |f| {
+            f.applied >= id && f.snapshot.step > saved.snapshot.step + 5
+        })
+        .expect("runs on");
+        let file = states::list(&dir).remove(0);
+        let id = h.send(Command::LoadState(file));
+        let f = h.wait_for(WAIT, |f| f.applied >= id).unwrap();
+        assert_eq!(f.state, RunState::Paused);
+        assert_eq!(f.snapshot.step, saved.snapshot.step);
+        assert_eq!(f.snapshot.time.to_bits(), saved.snapshot.time.to_bits());
+        assert!(f.generation > saved.generation, "plots start over");
+        assert!(f.notice.as_ref().is_some_and(|n| n.0 == id));
+        // A file that is not a checkpoint is an error line, and the run stays as it was.
+        let bad = dir.join("checkpoint_9.000000.ckpt");
+        std::fs::write(&bad, b"not a checkpoint").unwrap();
+        let id = h.send(Command::LoadState(bad));
+        let f = h.wait_for(WAIT, |f| f.applied >= id).unwrap();
+        assert!(
+            f.error
+                .as_deref()
+                .is_some_and(|e| e.contains("not a dda3d checkpoint"))
+        );
+        assert_eq!(f.snapshot.step, saved.snapshot.step);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

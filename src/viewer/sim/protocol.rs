@@ -1,6 +1,7 @@
 //! The protocol between the window and the simulation thread: the commands the window sends,
 //! the frames and per-step records the thread publishes, and the run's state and speed.
 
+use std::path::PathBuf;
 use std::sync::Arc;
 
 use crate::params::SolverParams;
@@ -36,6 +37,11 @@ pub enum Command {
     /// Rejected with a message when [`SolverParams::validate`] fails.
     SetParams(Box<SolverParams>),
     SetSpeed(Speed),
+    /// Save the solver's state as `DIR/checkpoint_<t>.ckpt` (the format of `run
+    /// --checkpoint-every`).
+    SaveState(PathBuf),
+    /// Replace the run with the state in this checkpoint file (of the same scene), paused.
+    LoadState(PathBuf),
     /// Stop the thread.
     Quit,
 }
@@ -69,6 +75,9 @@ pub struct Frame {
     pub speed: Speed,
     /// The last solver error, or a rejected command, as one line.
     pub error: Option<String>,
+    /// The outcome of the last Save state or Load state that succeeded, with the id of its
+    /// command (so the window shows it once).
+    pub notice: Option<(u64, String)>,
     /// Solver steps per wall-clock second while running (over the last ~0.5 s; 0 when idle).
     pub steps_per_second: f64,
     /// Mean wall time of one step, s (over the same window).

@@ -6,7 +6,7 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use super::{Command, Frame, Mailbox, RunState, Speed, StepRecord, lock};
+use super::{Command, Frame, Mailbox, RunState, Speed, StepRecord, lock, states};
 use crate::model::Model;
 use crate::params::SolverParams;
 use crate::snapshot::ContactState;
@@ -77,6 +77,8 @@ struct Sim {
     state: RunState,
     speed: Speed,
     error: Option<String>,
+    /// See [`Frame::notice`].
+    notice: Option<(u64, String)>,
     /// A single step was requested while paused.
     step_once: bool,
     applied: u64,
@@ -119,6 +121,7 @@ impl Sim {
             state: RunState::Paused,
             speed,
             error: None,
+            notice: None,
             step_once: false,
             applied: 0,
             generation: 0,
@@ -218,6 +221,22 @@ impl Sim {
         None
     }
 
+    /// Replaces the run (a reset, or a loaded state): new plots, no error, not stepping.
+    fn start_over(&mut self, solver: Solver) {
+        self.running_before = Duration::ZERO;
+        self.running_since = None;
+        self.solver = solver;
+        self.generation += 1;
+        self.records.clear();
+        self.error = None;
+        if self.state != RunState::Running || self.solver.finished() {
+            self.state = RunState::Paused;
+        }
+        self.step_once = false;
+        self.re_anchor();
+        self.reset_rate();
+    }
+
     fn re_anchor(&mut self) {
         self.anchor_wall = Instant::now();
         self.anchor_sim = self.solver.time;
@@ -258,20 +277,9 @@ impl Sim {
                 self.step_once = true;
             }
             Command::Reset => {
-                self.running_before = Duration::ZERO;
-                self.running_since = None;
                 let mut params = self.solver.params.clone();
                 params.duration = self.scene_duration;
-                self.solver = Solver::new(self.model.clone(), params);
-                self.generation += 1;
-                self.records.clear();
-                self.error = None;
-                if self.state != RunState::Running {
-                    self.state = RunState::Paused;
-                }
-                self.step_once = false;
-                self.re_anchor();
-                self.reset_rate();
+                self.start_over(Solver::new(self.model.clone(), params));
             }
             Command::SetParams(p) => match p.validate() {
                 Ok(()) => {
@@ -298,6 +306,18 @@ impl Sim {
                 self.speed = s;
                 self.re_anchor();
             }
+            Command::SaveState(dir) => match states::save(&self.solver, &dir) {
+                Ok(m) => self.notice = Some((id, m)),
+                Err(m) => self.error = Some(m),
+            },
+            Command::LoadState(path) => match states::load(&path, &self.model) {
+                Ok(solver) => {
+                    self.start_over(solver);
+                    self.state = RunState::Paused;
+                    self.notice = Some((id, format!("state loaded from {}", path.display())));
+                }
+                Err(m) => self.error = Some(m),
+            },
         }
         true
     }
@@ -391,6 +411,7 @@ impl Sim {
             state: self.state.clone(),
             speed: self.speed,
             error: self.error.clone(),
+            notice: self.notice.clone(),
             steps_per_second: if idle { 0.0 } else { self.steps_per_second },
             seconds_per_step: self.seconds_per_step,
             running_seconds: (self.running_before
