@@ -160,6 +160,25 @@ fn a_bad_output_interval_is_one_line_and_exit_2() {
         assert_eq!(err.trim().lines().count(), 1, "{err}");
         assert!(err.contains("--output-interval"), "{err}");
     }
+    // An interval without the VTK output it would set is a mistake, not ignored.
+    let o = bin()
+        .args([
+            "run",
+            scene.to_str().unwrap(),
+            "--output-interval",
+            "0.1",
+            "--out",
+        ])
+        .arg(dir.join("o3"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("add --vtk") && err.trim().lines().count() == 1,
+        "{err}"
+    );
+    assert!(!dir.join("o3").exists());
     let text =
         std::fs::read_to_string(&scene).unwrap() + "\n[output]\nvtk = true\ninterval = -0.1\n";
     let bad = dir.join("bad.toml");

@@ -270,10 +270,19 @@ pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
     }
     let (mut solver, rock_masses, output, default_out) = start(args)?;
     let out = args.out.clone().unwrap_or(default_out);
+    let write_vtk = args.vtk || output.vtk;
+    if args.output_interval.is_some() && !write_vtk {
+        // The CSV files take every step; an interval that changes nothing is a mistake to say.
+        return Err(Failure::Input(
+            "--output-interval sets the VTK output's interval: add --vtk (or [output] vtk = \
+             true in the scene)"
+                .into(),
+        ));
+    }
     exit::catch_stop_signals()?;
     let writer = RunWriter::create(&out).map_err(|e| Failure::Io(e.to_string()))?;
     let interval = args.output_interval.or(output.interval);
-    let vtk = (args.vtk || output.vtk)
+    let vtk = write_vtk
         .then(|| VtkWriter::create(&out, interval))
         .transpose()
         .map_err(|e| Failure::Io(e.to_string()))?;
