@@ -394,6 +394,76 @@ fn a_stack_of_slabs_on_a_joint_slides_as_one() {
     }
 }
 
+/// Slabs cut by a 75° cross set, whose blocks meet four to a junction, slide as one at
+/// Coulomb's rate (their travel in 0.5 s from rest within 1.5 %, their acceleration over the
+/// last 0.3 s within 2 %) with the penalty cap at γ = 1 (`[solver.contact] gamma`). With the
+/// paper's γ = 100 the first stack stopped within a step after 0.15 s (0.11 m in 0.5 s instead
+/// of 0.246 m): its slabs' joints sit exactly at their friction limit (each slab alone slides at
+/// the same rate), contacts rocking by micrometres had their penalties raised a hundredfold by
+/// (P21), their forces swung by 10⁵ N, and the iteration settled on a state that held the stack.
+///
+/// Not yet right, and said in the README: two slabs on 35° (φ 25°) travel 2.7 % short, three on
+/// 40° with φ 25° end 3.4 % slow, four cut by an 80° set still jam, and the 75° stack with φ
+/// above its dip creeps 0.4–1.5 mm in 0.5 s whatever γ is (100, 10 or 1). The shipped jointed
+/// slope keeps γ = 100: with γ = 1 its 5 m slice released its free blocks faster, but the whole
+/// slope jammed more (19 of its 35 free blocks past 10 cm at 3 s, against 30).
+#[test]
+fn slabs_cut_by_a_cross_set_slide_as_one_under_a_penalty_cap_of_one_e() {
+    for (dip, phi, layers, cross) in [(40.0f64, 30.0f64, 3, 75.0f64), (45.0, 35.0, 3, 75.0)] {
+        let t = 0.5;
+        let run = |phi: f64| {
+            let text = stack(dip, phi, layers, Some(cross));
+            let mut s =
+                scene::parse(&text, "stack.toml", "stack").unwrap_or_else(|e| panic!("{e}"));
+            s.params.contact.gamma = 1.0;
+            s.params.duration = t;
+            let mut solver = Solver::new(s.model, s.params);
+            let start = solver.snapshot();
+            let mut mid = None;
+            while !solver.finished() {
+                solver.step().expect("runs");
+                if mid.is_none() && solver.time >= t - 0.3 - 1e-9 {
+                    mid = Some(solver.snapshot());
+                }
+            }
+            (start, mid.expect("the last 0.3 s"), solver.snapshot())
+        };
+        let (start, mid, end) = run(phi);
+        let (dr, pr) = (dip.to_radians(), phi.to_radians());
+        let want = dda3d::rockmass::orientation::dip_vector(dip, 270.0)
+            * (G * (dr.sin() - dr.cos() * pr.tan()));
+        for ((b, b1), b0) in end
+            .blocks
+            .iter()
+            .zip(&mid.blocks)
+            .zip(&start.blocks)
+            .skip(1)
+        {
+            let a = (Vec3::from(b.velocity) - Vec3::from(b1.velocity)) / (end.time - mid.time);
+            let moved = Vec3::from(b.centroid) - Vec3::from(b0.centroid);
+            let travel = want * (0.5 * end.time * end.time);
+            eprintln!(
+                "dip {dip}, φ {phi}, {layers} slabs, cross {cross}: {}: a = {:.4} of {:.4} m/s², \
+                 moved {:.4} of {:.4} m",
+                b.name,
+                a.norm(),
+                want.norm(),
+                moved.norm(),
+                travel.norm()
+            );
+            // The travel from rest within 1.5 %; the acceleration of the last 0.3 s, a difference
+            // of two velocities through the junctions' rocking, within 2 %.
+            assert!(
+                (moved - travel).norm() < 0.015 * travel.norm()
+                    && (a - want).norm() < 0.02 * want.norm(),
+                "dip {dip}, φ {phi}, {layers} slabs, cross {cross}, {}: a = {a:?}, moved \
+                 {moved:?}; closed form {want:?}, {travel:?}",
+                b.name
+            );
+        }
+    }
+}
+
 /// A 5 m wide slice of the shipped `scenes/jointed_slope.toml`, run for 1 s after its
 /// equilibrium stage: every block of the upper mass above J1's lowest daylighting plane (F =
 /// 0.67) slides out (Coulomb's 1.9 m/s² gives 0.95 m; those behind lag), and every other block
@@ -450,6 +520,9 @@ fn a_slice_of_the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
     // The free blocks behind the face push on those in front and lag them: at least 3 cm each
     // (15 times the most any other block moves), half of them more than 10 cm.
     assert!(free.len() >= 10, "{} free blocks", free.len());
+    // Coulomb's motion gives 0.95 m; the blocks behind the face slabs lag them (measured: the
+    // least-moved 6.6 cm, the median 21 cm; with γ = 1, 34 cm and 43 cm, but see the README:
+    // on the whole slope γ = 1 did worse).
     assert!(least > 0.03, "a free block moved {least} m");
     assert!(
         median > 0.1,
