@@ -181,10 +181,15 @@ fn update_multipliers(
         // Not for a contact whose penetration is already negligible against the tolerance
         // ε1·d_n,max: there the ratio test only sees round-off, and over many steps it
         // ratcheted every penalty of a standing wall up to γE, a stiffness that turned a 4 µm
-        // motion into meganewtons at the next impact.
+        // motion into meganewtons at the next impact. Nor for a closed contact the solve pulls
+        // apart (d_n < 0): a stiffer penalty only lets it hold more tension, and the open–close
+        // check, not the penalty, deals with it. Slabs sliding together rock on their joints
+        // by micrometres; raised there a hundredfold, the penalties swung their forces by
+        // 10⁵ N and the iteration settled on states that stopped the slabs within a step.
         if let Some(prev) = c.dn_prev
             && alm_k <= PENALTY_ROUNDS + 1
             && !converged
+            && (c.dn > 0.0 || -c.dn > cp.eps1 * c.dn_max(p))
             && c.dn.abs() > cp.beta * prev.abs()
             && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * c.dn_max(p)
         {
