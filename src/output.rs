@@ -264,6 +264,14 @@ impl RunWriter {
     }
 }
 
+/// Which interval of length `dt` the time `t` falls in, a step a hair short of a multiple
+/// counted in the next. Outputs at an interval (`--output-interval`, `--checkpoint-every`) take
+/// the first step at or past each multiple: steps do not end on them, and this keeps the
+/// schedule a function of time alone.
+pub(crate) fn interval_slot(t: f64, dt: f64) -> i64 {
+    (t / dt + 1e-9).floor() as i64
+}
+
 /// Writes `bytes` to `path` atomically: into a temporary file in the same directory, then
 /// renamed over `path`, so a reader (or a kill) never meets a half-written file.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> io::Result<()> {

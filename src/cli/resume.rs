@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use super::SolverOverrides;
 use super::exit::Failure;
-use crate::output::{OutputError, slug};
+use crate::output::{OutputError, interval_slot, slug};
 use crate::solver::{Solver, checkpoint};
 use crate::text::short;
 
@@ -69,7 +69,7 @@ pub(super) fn default_out(solver: &Solver) -> PathBuf {
 pub(super) struct Checkpoints {
     every: Option<f64>,
     /// The multiple of `every` the next checkpoint waits for.
-    next: u64,
+    next: i64,
 }
 
 impl Checkpoints {
@@ -81,8 +81,8 @@ impl Checkpoints {
 
     /// The first multiple after `time` (a step that lands a rounding error short of a multiple
     /// counts as on it).
-    fn after(time: f64, every: f64) -> u64 {
-        (time / every + 1e-9).floor() as u64 + 1
+    fn after(time: f64, every: f64) -> i64 {
+        interval_slot(time, every) + 1
     }
 
     /// Called after each step of the run: writes `dir/checkpoint_<t>.ckpt` when one is due.
@@ -90,7 +90,7 @@ impl Checkpoints {
         let Some(every) = self.every else {
             return Ok(());
         };
-        if solver.time < (self.next as f64 - 1e-9) * every {
+        if interval_slot(solver.time, every) < self.next {
             return Ok(());
         }
         let path = dir.join(checkpoint::file_name(solver.time));

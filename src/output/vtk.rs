@@ -27,7 +27,7 @@ use std::path::{Path, PathBuf};
 
 use base64::Engine;
 
-use super::{OutputError, num, write_atomically};
+use super::{OutputError, interval_slot as slot, num, write_atomically};
 use crate::snapshot::{ContactMode, ContactState, Snapshot};
 
 /// Writes the VTK series of a run.
@@ -101,12 +101,6 @@ impl VtkWriter {
         write_atomically(&path, text.as_bytes())
             .map_err(|e| OutputError::io(&path, "cannot write", e))
     }
-}
-
-/// Which interval of length `dt` the time `t` falls in, a step a hair short of a multiple
-/// counted in the next.
-fn slot(t: f64, dt: f64) -> i64 {
-    (t / dt + 1e-9).floor() as i64
 }
 
 /// A `.pvd` collection of (time, file) pairs.
