@@ -79,7 +79,7 @@ fn vertex_face(
     ib: usize,
     b: &Shape,
     p: &DetectionParams,
-    known: &dyn Fn(&ContactKey) -> bool,
+    known: &(dyn Fn(&ContactKey) -> bool + Sync),
     out: &mut Vec<Candidate>,
 ) {
     let reach = Reach::around(b, p.search_distance);
@@ -188,7 +188,7 @@ fn choose_face(
     ib: usize,
     mut passing: Vec<Alternative>,
     tie: f64,
-    known: &dyn Fn(&ContactKey) -> bool,
+    known: &(dyn Fn(&ContactKey) -> bool + Sync),
 ) -> Option<Candidate> {
     let key = |face: u32| ContactKey {
         i: ia as u32,
@@ -274,13 +274,25 @@ fn edge_edge(
     out: &mut Vec<Candidate>,
 ) {
     let reach = Reach::around(b, p.search_distance);
+    // The edges of b that can come within |gap| ≤ max(d_s, d_max) of an edge of a: the closest
+    // point on b's edge then lies in a's box grown by that much (grown a little more here, so
+    // that rounding never culls an edge the test below would keep).
+    let limit = p.search_distance.max(p.max_penetration);
+    let reach_a = Reach::around(a, limit * (1.0 + 1e-6) + 1e-12);
+    let near_b: Vec<usize> = (0..b.topo.edges.len())
+        .filter(|&k| {
+            let eb = &b.topo.edges[k];
+            reach_a.holds(&b.vertices[eb.v[0]], &b.vertices[eb.v[1]])
+        })
+        .collect();
     for (ea_i, ea) in a.topo.edges.iter().enumerate() {
         let (p1, p2) = (a.vertices[ea.v[0]], a.vertices[ea.v[1]]);
         if !reach.holds(&p1, &p2) {
             continue;
         }
         let e1 = p2 - p1;
-        for (eb_i, eb) in b.topo.edges.iter().enumerate() {
+        for &eb_i in &near_b {
+            let eb = &b.topo.edges[eb_i];
             let (p3, p4) = (b.vertices[eb.v[0]], b.vertices[eb.v[1]]);
             let e2 = p4 - p3;
             let c = e1.cross(&e2);
@@ -303,7 +315,7 @@ fn edge_edge(
             let xb = p3 + e2 * t;
             let mut normal = c / cn;
             let gap0 = (xa - xb).dot(&normal);
-            if gap0.abs() > p.search_distance.max(p.max_penetration) {
+            if gap0.abs() > limit {
                 continue;
             }
             // Orientation: the faces of b at its edge on the −n side, those of a on the +n side.
@@ -372,20 +384,21 @@ pub fn detect_pair(
     b: usize,
     sb: &Shape,
     p: &DetectionParams,
-    known: &dyn Fn(&ContactKey) -> bool,
+    known: &(dyn Fn(&ContactKey) -> bool + Sync),
 ) -> Vec<Candidate> {
     let mut all = Vec::new();
     vertex_face(a, sa, b, sb, p, known, &mut all);
     vertex_face(b, sb, a, sa, p, known, &mut all);
     edge_edge(a, sa, b, sb, p, &mut all);
-    all.sort_by(|x, y| {
-        known(&y.key)
-            .cmp(&known(&x.key))
+    // Looked up once per candidate, not once per comparison.
+    let mut all: Vec<(bool, Candidate)> = all.into_iter().map(|c| (known(&c.key), c)).collect();
+    all.sort_by(|(kx, x), (ky, y)| {
+        ky.cmp(kx)
             .then(y.gap.total_cmp(&x.gap))
             .then(x.key.cmp(&y.key))
     });
     let mut kept: Vec<Candidate> = Vec::with_capacity(all.len());
-    for c in all {
+    for (_, c) in all {
         let mid = (c.xa + c.xb) / 2.0;
         if kept
             .iter()

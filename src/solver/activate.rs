@@ -4,6 +4,8 @@
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use super::active::Active;
 use super::counters::debug_log;
 use super::step_control::max_step_penetration;
@@ -37,7 +39,7 @@ pub(crate) struct ActivationInputs<'a> {
 /// other (the broad phase's pairs, sorted).
 pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let p = inp.params;
-    let shapes: Vec<Shape> = inp.blocks.iter().map(Shape::of).collect();
+    let shapes: Vec<Shape> = inp.blocks.par_iter().map(Shape::of).collect();
     let bounds = inp
         .blocks
         .iter()
@@ -46,14 +48,18 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
         .collect();
     let groups = ContactGroups::find(bounds, p.max_displacement_ratio);
     let known = |k: &ContactKey| inp.records.contains_key(k);
-    let mut cands: Vec<Candidate> = Vec::new();
-    for &(a, b) in &groups.pairs {
-        let dp = DetectionParams {
-            check_crossing_depth: p.method == Method::Alm,
-            ..DetectionParams::new(groups.pair_w0(a, b), p.max_displacement_ratio)
-        };
-        cands.extend(detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known));
-    }
+    // The narrow phase, pair by pair in parallel; collected in the order of the pairs.
+    let cands: Vec<Candidate> = groups
+        .pairs
+        .par_iter()
+        .flat_map_iter(|&(a, b)| {
+            let dp = DetectionParams {
+                check_crossing_depth: p.method == Method::Alm,
+                ..DetectionParams::new(groups.pair_w0(a, b), p.max_displacement_ratio)
+            };
+            detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known)
+        })
+        .collect();
     // Contact transfer: a vertex that slid onto an adjacent, almost coplanar face of the same
     // block keeps its history.
     let mut by_vertex: HashMap<(u32, u32, u32), ContactKey> = HashMap::new();
@@ -63,7 +69,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
         }
     }
     let (mut active, new): (Vec<Active>, Vec<bool>) = cands
-        .into_iter()
+        .into_par_iter()
         .map(|cand| {
             let w0 = groups.group_w0(cand.key.i as usize);
             activate_one(inp, &by_vertex, cand, w0)

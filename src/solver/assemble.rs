@@ -2,6 +2,8 @@
 //! attempt, each closed contact's stiffness and forces, the sparsity pattern of a step, and K
 //! kept up to date contact by contact as states and penalties change.
 
+use rayon::prelude::*;
+
 use super::active::{Active, StiffnessKey};
 use crate::contact::ContactState;
 use crate::contact::kinematics::{
@@ -50,7 +52,7 @@ pub(crate) fn block_terms(
     dt: f64,
 ) -> (Vec<Mat12>, Vec<Vec12>) {
     blocks
-        .iter()
+        .par_iter()
         .map(|b| {
             let t = one_block(p, b, scheme, &b.kinematics(), dt);
             (t.k, t.f)

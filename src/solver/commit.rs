@@ -5,6 +5,7 @@
 use std::collections::HashMap;
 
 use nalgebra::Vector6;
+use rayon::prelude::*;
 
 use super::active::Active;
 use crate::contact::record::ContactRecord;
@@ -19,7 +20,7 @@ use crate::snapshot::{ContactSnapshot, StepStats};
 /// The end-of-step map of every block's material points for the solution `d`.
 pub(crate) fn step_maps(blocks: &[Block], d: &[f64]) -> Vec<StepMap> {
     blocks
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(i, b)| {
             let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
@@ -35,64 +36,77 @@ pub(crate) fn commit_contacts(
     maps: &[StepMap],
     active: &[Active],
 ) -> (HashMap<ContactKey, ContactRecord>, Vec<ContactSnapshot>) {
+    // Each contact's record and snapshot in parallel, gathered in the contacts' order.
+    let committed: Vec<(ContactKey, ContactRecord, Option<ContactSnapshot>)> = active
+        .par_iter()
+        .map(|c| commit_contact(p, maps, c))
+        .collect();
     let mut contacts = Vec::new();
     let mut records = HashMap::with_capacity(active.len());
-    for c in active {
-        let mut rec = c.rec;
-        let closed = rec.state.is_closed();
-        rec.penetration = c.dn + rec.overlap;
-        // The tangential force on block i: the spring pulls a locked contact back toward its
-        // reference, friction acts against a sliding one's slip τ.
-        let mut shear = Vec3::zeros();
-        if closed {
-            rec.normal_force = c.force;
-            let (magnitude, direction) = match rec.state {
-                ContactState::Lock => (
-                    p.contact.shear_penalty(rec.penalty) * c.shear.norm(),
-                    -c.shear.try_normalize(0.0).unwrap_or_else(Vec3::zeros),
-                ),
-                _ => {
-                    let n_prev = if p.method == Method::Alm {
-                        rec.lambda
-                    } else {
-                        rec.normal_force.max(0.0)
-                    };
-                    (n_prev * c.tan_phi(p), -rec.tau)
-                }
-            };
-            rec.shear_force = magnitude;
-            shear = direction * magnitude;
-        } else {
-            rec.normal_force = 0.0;
-            rec.shear_force = 0.0;
-        }
-        let mj = &maps[c.cand.key.j as usize];
-        rec.reference = mj.apply(&rec.reference);
-        rec.tau = mj.rotation() * rec.tau;
-        if closed {
-            contacts.push(ContactSnapshot {
-                block_i: c.cand.key.i as usize,
-                block_j: c.cand.key.j as usize,
-                mode: c.cand.mode(),
-                state: rec.state,
-                point: mj.apply(&c.cand.xb).into(),
-                normal: (mj.rotation() * c.cand.normal).into(),
-                normal_force: rec.normal_force,
-                shear_force: rec.shear_force,
-                shear: (mj.rotation() * shear).into(),
-                penetration: c.dn + rec.overlap,
-                penalty: rec.penalty,
-                joint: c.joint,
-                lambda: if p.method == Method::Alm {
-                    rec.lambda
-                } else {
-                    0.0
-                },
-            });
-        }
-        records.insert(c.cand.key, rec);
+    for (key, rec, snap) in committed {
+        contacts.extend(snap);
+        records.insert(key, rec);
     }
     (records, contacts)
+}
+
+/// One contact's record for the next step and, if closed, its snapshot.
+fn commit_contact(
+    p: &SolverParams,
+    maps: &[StepMap],
+    c: &Active,
+) -> (ContactKey, ContactRecord, Option<ContactSnapshot>) {
+    let mut rec = c.rec;
+    let closed = rec.state.is_closed();
+    rec.penetration = c.dn + rec.overlap;
+    // The tangential force on block i: the spring pulls a locked contact back toward its
+    // reference, friction acts against a sliding one's slip τ.
+    let mut shear = Vec3::zeros();
+    if closed {
+        rec.normal_force = c.force;
+        let (magnitude, direction) = match rec.state {
+            ContactState::Lock => (
+                p.contact.shear_penalty(rec.penalty) * c.shear.norm(),
+                -c.shear.try_normalize(0.0).unwrap_or_else(Vec3::zeros),
+            ),
+            _ => {
+                let n_prev = if p.method == Method::Alm {
+                    rec.lambda
+                } else {
+                    rec.normal_force.max(0.0)
+                };
+                (n_prev * c.tan_phi(p), -rec.tau)
+            }
+        };
+        rec.shear_force = magnitude;
+        shear = direction * magnitude;
+    } else {
+        rec.normal_force = 0.0;
+        rec.shear_force = 0.0;
+    }
+    let mj = &maps[c.cand.key.j as usize];
+    rec.reference = mj.apply(&rec.reference);
+    rec.tau = mj.rotation() * rec.tau;
+    let snap = closed.then(|| ContactSnapshot {
+        block_i: c.cand.key.i as usize,
+        block_j: c.cand.key.j as usize,
+        mode: c.cand.mode(),
+        state: rec.state,
+        point: mj.apply(&c.cand.xb).into(),
+        normal: (mj.rotation() * c.cand.normal).into(),
+        normal_force: rec.normal_force,
+        shear_force: rec.shear_force,
+        shear: (mj.rotation() * shear).into(),
+        penetration: c.dn + rec.overlap,
+        penalty: rec.penalty,
+        joint: c.joint,
+        lambda: if p.method == Method::Alm {
+            rec.lambda
+        } else {
+            0.0
+        },
+    });
+    (c.cand.key, rec, snap)
 }
 
 /// Moves every block by its solution: velocity (3.2) v1 = 2D/Δt − v0 or its generalized-α form
@@ -105,7 +119,7 @@ pub(crate) fn commit_blocks(
     dt: f64,
     scheme: &Scheme,
 ) {
-    for (i, b) in blocks.iter_mut().enumerate() {
+    blocks.par_iter_mut().enumerate().for_each(|(i, b)| {
         let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
         b.set_kinematics(scheme.advance(&b.kinematics(), &di, dt));
         let de = di.fixed_rows::<6>(6).into_owned();
@@ -124,7 +138,7 @@ pub(crate) fn commit_blocks(
             *pt = map.apply(pt);
         }
         b.refresh();
-    }
+    });
 }
 
 /// The step's statistics from its contacts: the largest penetration and kept overlap of a
