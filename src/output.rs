@@ -8,7 +8,10 @@
 //! `summary.json` is replaced atomically (written beside it, then renamed), so it is always
 //! one whole JSON document. [`vtk`] writes the ParaView series.
 
+mod background;
 pub mod vtk;
+
+pub use background::RunWriter;
 
 use std::fs::File;
 use std::io::{self, Seek, SeekFrom, Write};
@@ -26,7 +29,7 @@ use crate::snapshot::{EquilibriumReport, RunTotals, Timings};
 const STAGE_LIMIT: usize = 16 << 10;
 
 /// A file of the run that could not be created or written, and why.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub struct OutputError {
     pub path: PathBuf,
     pub message: String,
@@ -111,11 +114,11 @@ impl StagedCsv {
     }
 }
 
-/// Streams one row per block and one per active contact for every completed step.
-pub struct RunWriter {
+/// Streams one row per block and one per active contact for every completed step (on the
+/// thread of [`RunWriter`]).
+pub(crate) struct RowWriter {
     blocks: StagedCsv,
     contacts: StagedCsv,
-    dir: PathBuf,
     /// Time of the last step staged, and of the last step on disk in both files.
     staged_time: Option<f64>,
     written_time: Option<f64>,
@@ -147,7 +150,7 @@ fn create_output_dir(dir: &Path) -> Result<(), OutputError> {
         .map_err(|e| OutputError::io(dir, "cannot create the output directory", e))
 }
 
-impl RunWriter {
+impl RowWriter {
     /// Creates `dir` and the two CSV files, their headers staged.
     pub fn create(dir: &Path) -> Result<Self, OutputError> {
         create_output_dir(dir)?;
@@ -177,18 +180,13 @@ impl RunWriter {
                 "joint",
             ],
         )?;
-        Ok(RunWriter {
+        Ok(RowWriter {
             blocks,
             contacts,
-            dir: dir.to_path_buf(),
             staged_time: None,
             written_time: None,
             failed: false,
         })
-    }
-
-    pub fn dir(&self) -> &Path {
-        &self.dir
     }
 
     /// Time of the last step whose rows are on disk, complete, in both files.
