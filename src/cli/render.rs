@@ -51,6 +51,10 @@ pub struct RenderArgs {
     /// Draw no contact arrows: the blocks alone (a rock mass of thousands of contacts).
     #[arg(long)]
     pub no_arrows: bool,
+    /// Arrows at the N contacts with the largest normal force only, or `all` (default: the
+    /// strongest 500; the legend says when some are left out).
+    #[arg(long, value_name = "N|all")]
+    pub arrows: Option<String>,
     /// Transparent background.
     #[arg(long)]
     pub transparent: bool,
@@ -203,6 +207,16 @@ fn capture_options(args: &RenderArgs, out: &Path) -> Result<CaptureOptions, CliE
             )));
         }
         opts.style.force_scale = Some(f);
+    }
+    if let Some(a) = &args.arrows {
+        opts.style.arrow_limit = match a.as_str() {
+            "all" => None,
+            n => Some(n.parse::<usize>().ok().filter(|&n| n > 0).ok_or_else(|| {
+                CliError::Input(format!(
+                    "--arrows takes a positive count or `all`, got {a:?}"
+                ))
+            })?),
+        };
     }
     if args.normals {
         opts.style.arrows = ArrowMode::Both;

@@ -90,7 +90,8 @@ pub fn paint_overlay(painter: &egui::Painter, scene: &RenderScene, camera: &Came
         y = legends.field(f, y);
     }
     if let Some(scale) = scene.force_scale {
-        y = legends.forces(scale, (scene.contacts_lock, scene.contacts_slide), y);
+        let counts = (scene.contacts_lock, scene.contacts_slide);
+        y = legends.forces(scale, counts, scene.arrows_shown, y);
     }
     if let Some(step) = scene.grid_step {
         legends.grid(step, y);
@@ -173,11 +174,22 @@ impl Legends<'_> {
         top - 20.0
     }
 
-    /// Arrow scale, then sample arrows in the lock and slide colours with their counts.
-    fn forces(&self, scale: f64, (locks, slides): (usize, usize), y: f32) -> f32 {
+    /// Arrow scale (and how many contacts have arrows, when not all), then sample arrows in the
+    /// lock and slide colours with their counts.
+    fn forces(
+        &self,
+        scale: f64,
+        (locks, slides): (usize, usize),
+        shown: Option<usize>,
+        y: f32,
+    ) -> f32 {
         let (painter, x, font) = (self.painter, self.x, &self.font);
+        let strongest = shown.map_or(String::new(), |n| format!(" (the strongest {n})"));
         let line1 = painter.layout_no_wrap(
-            format!("contact force: 1 m of arrow = {}", format_force(scale)),
+            format!(
+                "contact force: 1 m of arrow = {}{strongest}",
+                format_force(scale)
+            ),
             font.clone(),
             TEXT,
         );

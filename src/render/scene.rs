@@ -41,6 +41,10 @@ impl Coloring {
     }
 }
 
+/// Contacts drawn with arrows by default: the strongest this many. Every shipped scene but the
+/// jointed slope has fewer, so their pictures show every contact.
+pub const DEFAULT_ARROW_LIMIT: usize = 500;
+
 /// Which contact arrows to draw.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ArrowMode {
@@ -63,8 +67,11 @@ pub struct SceneStyle {
     pub field_range: Option<(f64, f64)>,
     pub arrows: ArrowMode,
     /// Newtons per metre of force arrow; `None` = chosen so that the largest force in the frame
-    /// is about 20 % of the scene size, rounded to a 1–2–2.5–5 number.
+    /// is about as long as a block (at most 20 % of the scene), rounded to a 1–2–2.5–5 number.
     pub force_scale: Option<f64>,
+    /// Draw the arrows of at most this many contacts, the strongest (largest |N|); `None` =
+    /// all. Ten thousand arrows on a rock mass hide it; the strongest show its load paths.
+    pub arrow_limit: Option<usize>,
     /// Transparent background (alpha 0) instead of the light grey one.
     pub transparent: bool,
     pub grid: bool,
@@ -80,6 +87,7 @@ impl Default for SceneStyle {
             field_range: None,
             arrows: ArrowMode::Forces,
             force_scale: None,
+            arrow_limit: Some(DEFAULT_ARROW_LIMIT),
             transparent: false,
             grid: true,
             edges: true,
@@ -185,6 +193,8 @@ pub struct RenderScene {
     pub field: Option<FieldLegend>,
     pub contacts_lock: usize,
     pub contacts_slide: usize,
+    /// Contacts drawn with arrows, when [`SceneStyle::arrow_limit`] left some out.
+    pub arrows_shown: Option<usize>,
     pub transparent: bool,
     pub overlay: bool,
     /// Grid spacing in metres, when a grid is drawn.
@@ -228,6 +238,7 @@ impl RenderScene {
             field,
             contacts_lock: contacts.lock,
             contacts_slide: contacts.slide,
+            arrows_shown: contacts.shown,
             transparent: style.transparent,
             overlay: style.overlay,
             grid_step,
@@ -343,6 +354,8 @@ struct ContactArrows {
     force_scale: Option<f64>,
     lock: usize,
     slide: usize,
+    /// How many contacts have arrows, when not all of them do.
+    shown: Option<usize>,
 }
 
 /// Radius and length of the glyphs, m.
@@ -355,7 +368,10 @@ struct GlyphSize {
 impl ContactArrows {
     fn build(snap: &Snapshot, style: &SceneStyle, frame: &SceneFrame) -> ContactArrows {
         let size = frame.size();
-        let usable: Vec<&ContactSnapshot> = snap
+        // Arrow lengths and thickness follow the blocks, within the scene's size: on a rock
+        // mass of a thousand blocks an arrow a fifth of the scene long crosses fifty blocks.
+        let block = typical_block_size(snap).unwrap_or(size);
+        let mut usable: Vec<&ContactSnapshot> = snap
             .contacts
             .iter()
             .filter(|c| {
@@ -366,6 +382,12 @@ impl ContactArrows {
             })
             .collect();
         let count = |s: ContactState| usable.iter().filter(|c| c.state == s).count();
+        let (lock, slide, total) = (
+            count(ContactState::Lock),
+            count(ContactState::Slide),
+            usable.len(),
+        );
+        strongest(&mut usable, style.arrow_limit);
         let draw_forces = matches!(style.arrows, ArrowMode::Forces | ArrowMode::Both);
         let draw_normals = matches!(style.arrows, ArrowMode::Normals | ArrowMode::Both);
         let force_scale = (draw_forces && !usable.is_empty()).then(|| match style.force_scale {
@@ -375,12 +397,9 @@ impl ContactArrows {
                     .iter()
                     .map(|c| c.normal_force.abs())
                     .fold(0.0, f64::max);
-                auto_force_scale(max_force, size)
+                auto_force_scale(max_force, size, block)
             }
         });
-        // Arrow thickness follows the scene size, but stays thin next to the blocks when they
-        // are small in a large scene (metre rocks on a kilometre slope).
-        let block = typical_block_size(snap).unwrap_or(size);
         let glyph = GlyphSize {
             shaft: (size * 0.005).min(block * 0.06) as f32,
             normal_len: (size * 0.06).min(block * 0.5) as f32,
@@ -389,7 +408,7 @@ impl ContactArrows {
         for c in &usable {
             let base = (DVec3::from_array(c.point) - frame.origin()).as_vec3();
             if let Some(scale) = force_scale {
-                push_force_arrow(&mut arrows, c, base, scale, size, glyph);
+                push_force_arrow(&mut arrows, c, base, scale, size.min(5.0 * block), glyph);
             }
             if draw_normals {
                 push_normal_glyph(&mut arrows, c, base, draw_forces, glyph);
@@ -398,8 +417,9 @@ impl ContactArrows {
         ContactArrows {
             arrows,
             force_scale,
-            lock: count(ContactState::Lock),
-            slide: count(ContactState::Slide),
+            lock,
+            slide,
+            shown: (usable.len() < total).then_some(usable.len()),
         }
     }
 }
@@ -477,188 +497,28 @@ fn typical_block_size(snap: &Snapshot) -> Option<f64> {
 
 /// N per metre of arrow so that the largest force draws about 20 % of the scene size, rounded
 /// up to a number a legend reads cleanly.
-pub fn auto_force_scale(max_force: f64, scene_size: f64) -> f64 {
+pub fn auto_force_scale(max_force: f64, scene_size: f64, block_size: f64) -> f64 {
     if !(max_force.is_finite() && max_force > 0.0) {
         return 1.0;
     }
-    mesh::nice_ceil(max_force / (0.20 * scene_size.max(1e-3)))
+    let longest = (0.20 * scene_size).min(block_size).max(1e-3);
+    mesh::nice_ceil(max_force / longest)
+}
+
+/// Keeps the `limit` contacts with the largest |N| (ties in their order), in their order.
+fn strongest(contacts: &mut Vec<&ContactSnapshot>, limit: Option<usize>) {
+    let Some(limit) = limit.filter(|&l| l < contacts.len()) else {
+        return;
+    };
+    let mut order: Vec<usize> = (0..contacts.len()).collect();
+    order.sort_by(|&a, &b| {
+        let f = |k: usize| contacts[k].normal_force.abs();
+        f(b).total_cmp(&f(a)).then(a.cmp(&b))
+    });
+    order.truncate(limit);
+    order.sort_unstable();
+    *contacts = order.into_iter().map(|k| contacts[k]).collect();
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::snapshot::*;
-
-    fn cube(name: &str, at: [f64; 3], fixed: bool) -> BlockSnapshot {
-        BlockSnapshot {
-            fixed,
-            velocity: [0.0, 0.0, -2.0],
-            displacement: [0.0, 0.0, -0.5],
-            rock_mass: None,
-            stress: [0.0; 6],
-            volume: 1.0,
-            ..BlockSnapshot::test_cube(name, at, 1.0)
-        }
-    }
-
-    fn snap(contacts: Vec<ContactSnapshot>) -> Snapshot {
-        Snapshot {
-            scene_name: "two cubes".into(),
-            time: 0.25,
-            step: 10,
-            blocks: vec![
-                cube("base", [0.0; 3], true),
-                cube("top", [0.0, 0.0, 1.0], false),
-            ],
-            contacts,
-            stats: StepStats::default(),
-            equilibrium: None,
-            rock_masses: Vec::new(),
-            joint_sets: Vec::new(),
-        }
-    }
-
-    fn contact(f: f64, state: ContactState) -> ContactSnapshot {
-        ContactSnapshot {
-            block_i: 1,
-            block_j: 0,
-            mode: ContactMode::VertexFace,
-            state,
-            point: [0.0, 0.0, 1.0],
-            normal: [0.0, 0.0, 1.0],
-            normal_force: f,
-            shear_force: 0.0,
-            shear: [0.0; 3],
-            penetration: 0.0,
-            penalty: 0.0,
-            lambda: 0.0,
-            joint: None,
-        }
-    }
-
-    #[test]
-    fn force_arrow_length_follows_scale() {
-        let s = snap(vec![contact(1000.0, ContactState::Lock)]);
-        let style = SceneStyle {
-            force_scale: Some(2000.0),
-            grid: false,
-            ..Default::default()
-        };
-        let frame = SceneFrame::of_snapshot(&s);
-        let scene = RenderScene::build(&s, &style, &frame).unwrap();
-        assert_eq!(scene.force_scale, Some(2000.0));
-        // 1000 N at 2000 N/m → 0.5 m arrow from the contact point along +z.
-        let base = scene.to_local([0.0, 0.0, 1.0]);
-        let top = scene
-            .arrows
-            .iter()
-            .map(|v| v.position[2] - base.z)
-            .fold(f32::MIN, f32::max);
-        assert!((top - 0.5).abs() < 1e-4, "arrow top {top}");
-        // A force far beyond the scale is capped at 40 % of the view.
-        let big = snap(vec![contact(1e6, ContactState::Lock)]);
-        let capped = RenderScene::build(&big, &style, &frame).unwrap();
-        let top_big = capped
-            .arrows
-            .iter()
-            .map(|v| v.position[2] - base.z)
-            .fold(f32::MIN, f32::max);
-        assert!(
-            (top_big - 0.4 * frame.size() as f32).abs() < 1e-3,
-            "capped top {top_big}"
-        );
-        assert_eq!(scene.contacts_lock, 1);
-        let lock = srgb_to_linear(hex(LOCK_SRGB));
-        assert!(scene.arrows.iter().all(|v| v.color == lock));
-    }
-
-    #[test]
-    fn auto_scale_and_slide_colour() {
-        let s = snap(vec![
-            contact(60154.0, ContactState::Slide),
-            contact(33204.0, ContactState::Lock),
-        ]);
-        let frame = SceneFrame::of_snapshot(&s);
-        let scene = RenderScene::build(&s, &SceneStyle::default(), &frame).unwrap();
-        let scale = scene.force_scale.unwrap();
-        let longest = 60154.0 / scale;
-        assert!(longest <= 0.20 * frame.size() + 1e-9 && longest > 0.08 * frame.size());
-        let slide = srgb_to_linear(hex(SLIDE_SRGB));
-        assert!(scene.arrows.iter().any(|v| v.color == slide));
-        assert_eq!((scene.contacts_lock, scene.contacts_slide), (1, 1));
-    }
-
-    #[test]
-    fn no_contacts_no_arrows_and_grid_present() {
-        let s = snap(vec![]);
-        let scene =
-            RenderScene::build(&s, &SceneStyle::default(), &SceneFrame::of_snapshot(&s)).unwrap();
-        assert!(scene.arrows.is_empty());
-        assert!(scene.force_scale.is_none());
-        assert!(scene.grid_step.is_some());
-        assert_eq!(scene.solids.len(), 2 * 6 * 2 * 3);
-        // 24 outline segments, the rest grid.
-        assert!(scene.lines.len() > 24);
-    }
-
-    #[test]
-    fn field_colouring_and_fixed_muted() {
-        let s = snap(vec![]);
-        let style = SceneStyle {
-            coloring: Coloring::Velocity,
-            ..Default::default()
-        };
-        let scene = RenderScene::build(&s, &style, &SceneFrame::of_snapshot(&s)).unwrap();
-        let f = scene.field.clone().unwrap();
-        assert_eq!((f.min, f.max), (0.0, 2.0));
-        // Fixed block keeps the stone grey, the moving one takes the top of the map.
-        assert_eq!(scene.solids[0].color, mesh::block_color(0, true));
-        assert_eq!(scene.solids.last().unwrap().color, mesh::colormap(1.0));
-    }
-
-    #[test]
-    fn bad_input_is_an_error_or_skipped() {
-        let mut s = snap(vec![contact(f64::NAN, ContactState::Lock)]);
-        let frame = SceneFrame::of_snapshot(&s);
-        let scene = RenderScene::build(&s, &SceneStyle::default(), &frame).unwrap();
-        assert!(scene.arrows.is_empty());
-        s.blocks[1].faces[0][0] = 42;
-        let err = RenderScene::build(&s, &SceneStyle::default(), &frame).unwrap_err();
-        assert!(err.to_string().contains("top"), "{err}");
-        assert!(matches!(err, RenderError::InvalidSnapshot(_)));
-    }
-
-    #[test]
-    fn empty_snapshot_frames_a_unit_box() {
-        let mut s = snap(vec![]);
-        s.blocks.clear();
-        let f = SceneFrame::of_snapshot(&s);
-        assert!(f.size() > 1.0);
-        assert!(RenderScene::build(&s, &SceneStyle::default(), &f).is_ok());
-    }
-
-    #[test]
-    fn arrows_stay_thin_next_to_small_blocks_in_a_big_scene() {
-        let mut s = snap(vec![contact(1000.0, ContactState::Lock)]);
-        // A 1 km fixed "slope" block and three 1 m cubes: the median block is 1 m across.
-        s.blocks[0]
-            .vertices
-            .iter_mut()
-            .for_each(|v| v.iter_mut().for_each(|x| *x *= 1000.0));
-        s.blocks.push(cube("c2", [5.0, 0.0, 1.0], false));
-        s.blocks.push(cube("c3", [7.0, 0.0, 1.0], false));
-        let frame = SceneFrame::of_snapshot(&s);
-        let scene = RenderScene::build(&s, &SceneStyle::default(), &frame).unwrap();
-        let base = scene.to_local([0.0, 0.0, 1.0]);
-        let radius = scene
-            .arrows
-            .iter()
-            .map(|v| {
-                let r = glam::Vec3::from(v.position) - base;
-                r.truncate().length()
-            })
-            .fold(0.0f32, f32::max);
-        // Head radius = 2.4 × shaft ≤ 2.4 × 0.06 × √3 m.
-        assert!(radius < 0.3, "arrow radius {radius} m next to 1 m blocks");
-    }
-}
+mod tests;

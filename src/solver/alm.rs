@@ -3,6 +3,8 @@
 //! (P21), until both convergence tests (P23) and (P24) hold. In penalty mode (DDA-3p) the loop
 //! is a single solve.
 
+use rayon::prelude::*;
+
 use super::active::Active;
 use super::assemble::{StiffnessSync, load_vector};
 use super::counters::{Counters, Stopwatch};
@@ -137,26 +139,33 @@ fn solve(
 /// (P23), each contact against its own group's d_n,max, and (P24); an unchanged zero force
 /// vector counts as converged.
 fn measure(p: &SolverParams, d: &[f64], active: &mut [Active]) -> (bool, bool) {
+    // Per contact in parallel; the sums of (P24) are then formed in the contacts' order, so
+    // they do not depend on the thread count.
+    let terms: Vec<(bool, f64, f64)> = active
+        .par_iter_mut()
+        .map(|c| {
+            let (di, dj) = c.increments(d);
+            c.dn = c.kin.penetration(&di, &dj);
+            if c.rec.state == ContactState::Open {
+                return (true, 0.0, 0.0);
+            }
+            let alm = p.method == Method::Alm;
+            let lambda = if alm { c.rec.lambda } else { 0.0 };
+            c.force = lambda + c.rec.penalty * c.dn;
+            let within = c.dn.abs() <= p.contact.eps1 * c.dn_max(p);
+            if !alm {
+                return (within, 0.0, 0.0);
+            }
+            let new = c.force.max(0.0);
+            (within, (new - c.rec.lambda).powi(2), c.rec.lambda.powi(2))
+        })
+        .collect();
     let mut conv1 = true;
     let (mut dl2, mut l2) = (0.0, 0.0);
-    for c in active.iter_mut() {
-        let (di, dj) = c.increments(d);
-        c.dn = c.kin.penetration(&di, &dj);
-        if c.rec.state == ContactState::Open {
-            continue;
-        }
-        let lambda = if p.method == Method::Alm {
-            c.rec.lambda
-        } else {
-            0.0
-        };
-        c.force = lambda + c.rec.penalty * c.dn;
-        conv1 &= c.dn.abs() <= p.contact.eps1 * c.dn_max(p);
-        if p.method == Method::Alm {
-            let new = c.force.max(0.0);
-            dl2 += (new - c.rec.lambda).powi(2);
-            l2 += c.rec.lambda.powi(2);
-        }
+    for (within, a, b) in terms {
+        conv1 &= within;
+        dl2 += a;
+        l2 += b;
     }
     let conv2 = dl2 == 0.0 || dl2.sqrt() < p.contact.eps2 * l2.sqrt();
     (conv1, conv2)
@@ -172,36 +181,40 @@ fn update_multipliers(
     active: &mut [Active],
 ) -> bool {
     let cp = &p.contact;
-    let mut raised = false;
-    for c in active.iter_mut() {
-        if c.rec.state == ContactState::Open {
-            continue;
-        }
-        c.rec.lambda = c.force.max(0.0);
-        // Not for a contact whose penetration is already negligible against the tolerance
-        // ε1·d_n,max: there the ratio test only sees round-off, and over many steps it
-        // ratcheted every penalty of a standing wall up to γE, a stiffness that turned a 4 µm
-        // motion into meganewtons at the next impact. Nor for a closed contact the solve pulls
-        // apart (d_n < 0): a stiffer penalty only lets it hold more tension, and the open–close
-        // check, not the penalty, deals with it. Slabs sliding together rock on their joints
-        // by micrometres; raised there a hundredfold, the penalties swung their forces by
-        // 10⁵ N and the iteration settled on states that stopped the slabs within a step.
-        if let Some(prev) = c.dn_prev
-            && alm_k <= PENALTY_ROUNDS + 1
-            && !converged
-            && (c.dn > 0.0 || -c.dn > cp.eps1 * c.dn_max(p))
-            && c.dn.abs() > cp.beta * prev.abs()
-            && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * c.dn_max(p)
-        {
-            let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
-            if capped > c.rec.penalty {
-                c.set_penalty(capped, cp);
-                raised = true;
+    // Each contact on its own, in parallel.
+    active
+        .par_iter_mut()
+        .map(|c| {
+            if c.rec.state == ContactState::Open {
+                return false;
             }
-        }
-        c.dn_prev = Some(c.dn);
-    }
-    raised
+            let mut raised = false;
+            c.rec.lambda = c.force.max(0.0);
+            // Not for a contact whose penetration is already negligible against the tolerance
+            // ε1·d_n,max: there the ratio test only sees round-off, and over many steps it
+            // ratcheted every penalty of a standing wall up to γE, a stiffness that turned a 4 µm
+            // motion into meganewtons at the next impact. Nor for a closed contact the solve pulls
+            // apart (d_n < 0): a stiffer penalty only lets it hold more tension, and the open–close
+            // check, not the penalty, deals with it. Slabs sliding together rock on their joints
+            // by micrometres; raised there a hundredfold, the penalties swung their forces by
+            // 10⁵ N and the iteration settled on states that stopped the slabs within a step.
+            if let Some(prev) = c.dn_prev
+                && alm_k <= PENALTY_ROUNDS + 1
+                && !converged
+                && (c.dn > 0.0 || -c.dn > cp.eps1 * c.dn_max(p))
+                && c.dn.abs() > cp.beta * prev.abs()
+                && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * c.dn_max(p)
+            {
+                let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
+                if capped > c.rec.penalty {
+                    c.set_penalty(capped, cp);
+                    raised = true;
+                }
+            }
+            c.dn_prev = Some(c.dn);
+            raised
+        })
+        .reduce(|| false, |a, b| a || b)
 }
 
 /// The tangential relative displacement of a locked contact in the solution `d`, m.
@@ -215,7 +228,7 @@ fn tangential_slip(c: &Active, d: &[f64], blocks: &[Block]) -> crate::physics::g
 /// its stick tolerance.
 fn stuck(inp: &AlmInputs, d: &[f64], active: &[Active]) -> bool {
     active
-        .iter()
+        .par_iter()
         .filter(|c| c.rec.state == ContactState::Lock)
         .all(|c| {
             tangential_slip(c, d, inp.blocks).norm()
@@ -238,7 +251,7 @@ fn stuck(inp: &AlmInputs, d: &[f64], active: &[Active]) -> bool {
 /// with 0.12 mm of slip; with f0·w0 in every step, a struck wall of 100 blocks needed 158 solves
 /// a step instead of 99 (57 with no stick update).
 fn absorb_stick_slip(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
-    for c in active.iter_mut() {
+    active.par_iter_mut().for_each(|c| {
         if c.rec.state == ContactState::Lock {
             let slip = tangential_slip(c, d, inp.blocks);
             c.rec.reference -= slip;
@@ -246,7 +259,7 @@ fn absorb_stick_slip(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
                 c.cap_shear(inp.params);
             }
         }
-    }
+    });
 }
 
 /// A sliding contact whose slip has reversed is in the wrong state, and its friction, from
@@ -256,13 +269,13 @@ fn absorb_stick_slip(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
 /// from that solution. The friction of such a contact is held at its present value for the rest
 /// of the pass (a change of F only: no refactorization); the open–close check locks it.
 fn hold_reversed_friction(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
-    for c in active.iter_mut() {
+    active.par_iter_mut().for_each(|c| {
         if c.rec.state != ContactState::Slide || c.frozen || c.friction_cap.is_some() {
-            continue;
+            return;
         }
         let du = c.relative_displacement(d, inp.blocks);
         if law::reversed(&du, &c.rec.tau, c.slip_tolerance(inp.params)) {
             c.friction_cap = Some(c.rec.lambda);
         }
-    }
+    });
 }

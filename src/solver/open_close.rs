@@ -3,6 +3,8 @@
 //! no contact changes state. Contacts that keep cycling are settled; at the pass limit the
 //! stragglers are settled or the attempt is redone.
 
+use rayon::prelude::*;
+
 use super::active::Active;
 use super::counters::{Counters, debug_log};
 use super::step_control::Retry;
@@ -37,51 +39,69 @@ pub(crate) fn check(
     active: &mut [Active],
     counters: &mut Counters,
 ) -> bool {
-    let mut changed = false;
-    for c in active.iter_mut() {
-        c.changed = false;
-        let clear = !c.frozen && c.reconsider_face(inp.params, d);
-        let n = c.cand.normal;
-        let du = c.relative_displacement(d, inp.blocks);
-        c.slip = du - n * n.dot(&du);
-        if c.frozen {
-            c.rec.normal_force = c.force;
-            continue;
-        }
-        let (verdict, shear) = if clear {
-            // The vertex has left block j through another face: it is no longer in contact.
-            c.rec.normal_force = c.force;
-            (Transition::Open, Vec3::zeros())
-        } else {
-            classify(inp, c, &du)
-        };
-        let before = c.rec.state;
-        apply(inp, c, verdict, shear);
-        if c.rec.state == before {
-            continue;
-        }
-        if debug_log() {
-            log_change(inp, c, before);
-        }
-        changed = true;
-        c.changed = true;
-        c.flips += 1;
-        if c.flips > MAX_FLIPS {
-            // A contact that keeps cycling (typically an edge–edge and a vertex–face contact
-            // of one block pair taking the load in turn) is settled for the rest of the
-            // attempt (see `law::Settled`); one whose spring has just exceeded its Mohr–Coulomb
-            // strength stays sliding, with its friction at capacity along that shear. Settled
-            // locked beyond its strength, it held blocks free to slide on their joint: the
-            // front blocks of a jointed slope, at a factor of safety of 0.67, stood for 2 s.
-            if !matches!(verdict, Transition::Slide { .. }) {
-                c.settle(inp.params);
-            }
-            counters.totals.frozen_contacts += (before != c.rec.state) as u64;
-            c.flips = 0;
-            c.frozen = true;
-        }
-    }
+    // Each contact's verdict depends on its own record and the solution alone, so contacts are
+    // checked in parallel (in order when the debug log is on, so that its lines keep their
+    // order); `any` and the count of settled contacts do not depend on the order.
+    let one = |c: &mut Active| check_one(inp, d, c);
+    let (changed, frozen) = if debug_log() {
+        active
+            .iter_mut()
+            .map(one)
+            .fold((false, 0), |(a, n), (b, m)| (a || b, n + m))
+    } else {
+        active
+            .par_iter_mut()
+            .map(one)
+            .reduce(|| (false, 0), |(a, n), (b, m)| (a || b, n + m))
+    };
+    counters.totals.frozen_contacts += frozen;
     changed
+}
+
+/// Checks one contact: whether it changed state, and whether it was settled in another state.
+fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
+    c.changed = false;
+    let clear = !c.frozen && c.reconsider_face(inp.params, d);
+    let n = c.cand.normal;
+    let du = c.relative_displacement(d, inp.blocks);
+    c.slip = du - n * n.dot(&du);
+    if c.frozen {
+        c.rec.normal_force = c.force;
+        return (false, 0);
+    }
+    let (verdict, shear) = if clear {
+        // The vertex has left block j through another face: it is no longer in contact.
+        c.rec.normal_force = c.force;
+        (Transition::Open, Vec3::zeros())
+    } else {
+        classify(inp, c, &du)
+    };
+    let before = c.rec.state;
+    apply(inp, c, verdict, shear);
+    if c.rec.state == before {
+        return (false, 0);
+    }
+    if debug_log() {
+        log_change(inp, c, before);
+    }
+    c.changed = true;
+    c.flips += 1;
+    let mut frozen = 0;
+    if c.flips > MAX_FLIPS {
+        // A contact that keeps cycling (typically an edge–edge and a vertex–face contact of one
+        // block pair taking the load in turn) is settled for the rest of the attempt (see
+        // `law::Settled`); one whose spring has just exceeded its Mohr–Coulomb strength stays
+        // sliding, with its friction at capacity along that shear. Settled locked beyond its
+        // strength, it held blocks free to slide on their joint: the front blocks of a jointed
+        // slope, at a factor of safety of 0.67, stood for 2 s.
+        if !matches!(verdict, Transition::Slide { .. }) {
+            c.settle(inp.params);
+        }
+        frozen = (before != c.rec.state) as u64;
+        c.flips = 0;
+        c.frozen = true;
+    }
+    (true, frozen)
 }
 
 /// The contact law's verdict on one contact, and the shear spring's extension N(Δ + Δu_ab) of

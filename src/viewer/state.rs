@@ -13,6 +13,7 @@ use glam::DVec3;
 use super::sim::{Command, Frame, RunState, Speed, StepRecord};
 use super::view::ViewControls;
 use crate::params::SolverParams;
+use crate::render::scene::DEFAULT_ARROW_LIMIT;
 use crate::render::{ArrowMode, Coloring, RenderScene, SceneFrame, SceneStyle};
 use crate::scene::Scene as SceneFile;
 use crate::snapshot::Snapshot;
@@ -38,6 +39,9 @@ pub struct Display {
     pub auto_force_scale: bool,
     /// Newtons per metre of arrow (manual scale).
     pub force_scale: f64,
+    /// Arrows for the strongest `arrow_limit` contacts only (else for all of them).
+    pub strongest_only: bool,
+    pub arrow_limit: usize,
     pub edges: bool,
     /// Outlines only, no faces.
     pub wireframe: bool,
@@ -56,6 +60,8 @@ impl Default for Display {
             normals: false,
             auto_force_scale: true,
             force_scale: 1e5,
+            strongest_only: true,
+            arrow_limit: DEFAULT_ARROW_LIMIT,
             edges: true,
             wireframe: false,
             grid: true,
@@ -371,6 +377,7 @@ impl UiState {
             } else {
                 Some(d.force_scale)
             },
+            arrow_limit: d.strongest_only.then_some(d.arrow_limit),
             transparent: false,
             grid: d.grid,
             edges: d.edges || d.wireframe,

@@ -54,6 +54,23 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState) {
                 );
             }
         });
+        ui.horizontal(|ui| {
+            ui.label("Show");
+            ui.selectable_value(&mut d.strongest_only, false, "all")
+                .on_hover_text("An arrow at every closed contact");
+            ui.selectable_value(&mut d.strongest_only, true, "strongest")
+                .on_hover_text(
+                    "Arrows at the contacts with the largest normal force only: on a rock mass \
+                     of thousands of contacts they show the load paths (and draw faster)",
+                );
+            if d.strongest_only {
+                ui.add(
+                    egui::Slider::new(&mut d.arrow_limit, 10..=20_000)
+                        .logarithmic(true)
+                        .text("contacts"),
+                );
+            }
+        });
     });
     ui.horizontal(|ui| {
         ui.checkbox(&mut d.edges, "Edges");
