@@ -3,13 +3,17 @@
 //! figures measured on the 2-core CI machine.
 
 mod cutting;
+mod threads;
+mod walls;
 
 pub use cutting::cut_table;
+pub use threads::thread_table;
+use walls::scaling_table;
 
 use std::path::Path;
 use std::time::Instant;
 
-use crate::generate::column_wall;
+use crate::output::RowWriter;
 use crate::params::Method;
 use crate::scene::{self, Scene};
 use crate::snapshot::RunTotals;
@@ -18,30 +22,51 @@ use crate::solver::{Solver, SolverError};
 /// One timed run.
 #[derive(Clone, Debug)]
 pub struct BenchRun {
+    /// Wall time of the solver's steps, s (output not included).
     pub wall: f64,
     pub simulated: f64,
     pub totals: RunTotals,
+    /// Wall time of formatting and writing each step's CSV rows (blocks.csv, contacts.csv into a
+    /// scratch directory), measured apart from the solver, s; `None` when not measured.
+    pub output: Option<f64>,
 }
 
-/// Runs a scene to its duration, timing the solver only (no output files).
-pub fn time_run(scene: &Scene) -> Result<BenchRun, SolverError> {
+/// Runs a scene to its duration, timing the solver only; with `output`, also times writing the
+/// CSV rows of every step (as `run` does, but on this thread, so the cost shows on its own).
+pub fn time_run(scene: &Scene, output: bool) -> Result<BenchRun, SolverError> {
     let mut s = Solver::new(scene.model.clone(), scene.params.clone());
-    let t = Instant::now();
+    let scratch = std::env::temp_dir().join(format!("dda3d-bench-{}", std::process::id()));
+    let mut rows = output.then(|| RowWriter::create(&scratch).ok()).flatten();
+    let (mut wall, mut writing) = (0.0, 0.0);
     while !s.finished() {
+        let t = Instant::now();
         s.step()?;
+        wall += t.elapsed().as_secs_f64();
+        if let Some(w) = rows.as_mut() {
+            let t = Instant::now();
+            // A scratch file that cannot be written only leaves the column empty.
+            if w.write(&s.snapshot()).and_then(|_| w.commit()).is_err() {
+                rows = None;
+            }
+            writing += t.elapsed().as_secs_f64();
+        }
     }
+    let measured = rows.is_some();
+    drop(rows);
+    let _ = std::fs::remove_dir_all(&scratch);
     Ok(BenchRun {
-        wall: t.elapsed().as_secs_f64(),
+        wall,
         simulated: s.time,
         totals: s.totals.clone(),
+        output: measured.then_some(writing),
     })
 }
 
 /// Best of `repeat` runs (the least disturbed by other load).
-pub fn best_of(scene: &Scene, repeat: usize) -> Result<BenchRun, SolverError> {
+pub fn best_of(scene: &Scene, repeat: usize, output: bool) -> Result<BenchRun, SolverError> {
     let mut best: Option<BenchRun> = None;
     for _ in 0..repeat.max(1) {
-        let r = time_run(scene)?;
+        let r = time_run(scene, output)?;
         if best.as_ref().is_none_or(|b| r.wall < b.wall) {
             best = Some(r);
         }
@@ -83,7 +108,7 @@ pub fn run(
     for method in [Method::Alm, Method::Penalty] {
         let mut s = base.clone();
         s.params.method = method;
-        let r = best_of(&s, repeat).map_err(|e| format!("{}: {e}", scene_path.display()))?;
+        let r = best_of(&s, repeat, false).map_err(|e| format!("{}: {e}", scene_path.display()))?;
         let t = &r.totals;
         let steps = t.steps as f64;
         let tm = &t.timings;
@@ -122,79 +147,6 @@ pub fn run(
     }
     if !standing_sizes.is_empty() {
         scaling_table(standing_sizes, repeat, scaling_duration, false)?;
-    }
-    Ok(())
-}
-
-/// One scaling table on generated walls, with or without the rockfall.
-fn scaling_table(sizes: &[usize], repeat: usize, duration: f64, rock: bool) -> Result<(), String> {
-    println!(
-        "\n## Scaling: generated walls (`dda3d generate column --blocks N{}`), ALM, {duration} s simulated\n",
-        if rock { "" } else { " --no-rock" }
-    );
-    if rock {
-        println!(
-            "With the rockfall: the cost includes the open–close and ALM iterations of the impact.\n"
-        );
-    } else {
-        println!(
-            "Standing wall, no rock: the cost of detection, assembly and factorization alone.\n"
-        );
-    }
-    println!(
-        "| N blocks | steps | contacts/step | solves/step | factorizations/step | cuts | wall s | wall s per simulated s | µs per contact-step | ms per factorization |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|---|");
-    let (mut ns, mut per_sim_s, mut walls, mut cs, mut cf) =
-        (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    for &n in sizes {
-        let text = column_wall(n, 5, rock);
-        let mut s = scene::parse(&text, &format!("generated wall of {n}"), "wall")
-            .map_err(|e| e.to_string())?;
-        s.params.duration = duration;
-        let r = best_of(&s, if n >= 1000 { 1 } else { repeat })
-            .map_err(|e| format!("wall of {n}: {e}"))?;
-        let t = &r.totals;
-        let contact_steps = t.contacts_per_step * t.steps as f64;
-        println!(
-            "| {n} | {} | {:.1} | {:.2} | {:.2} | {} | {:.3} | {:.3} | {:.2} | {:.3} |",
-            t.steps,
-            t.contacts_per_step,
-            t.alm_iterations as f64 / t.steps as f64,
-            t.factorizations as f64 / t.steps as f64,
-            t.time_step_cuts,
-            r.wall,
-            r.wall / r.simulated,
-            1e6 * r.wall / contact_steps,
-            1e3 * t.timings.factorization / t.factorizations.max(1) as f64
-        );
-        ns.push(n as f64);
-        per_sim_s.push(r.wall / r.simulated);
-        walls.push(r.wall);
-        cs.push(contact_steps);
-        // The work of the iterations: every factorization (and the assembly and bookkeeping
-        // around it) touches every contact once.
-        cf.push(t.contacts_per_step * t.factorizations as f64);
-    }
-    if ns.len() >= 2 {
-        println!(
-            "\nGrowth exponent (least squares on log-log, 1 = linear): wall time per simulated second against N: {:.2}; wall time against contact-steps: {:.2}; wall time against contact-factorizations (contacts × factorizations: the cost of the machinery for the iterations it was asked to do): {:.2}.",
-            growth_exponent(&ns, &per_sim_s),
-            growth_exponent(&cs, &walls),
-            growth_exponent(&cf, &walls)
-        );
-        let segments: Vec<String> = (1..ns.len())
-            .map(|i| {
-                format!(
-                    "{}→{}: {:.2} against contact-steps, {:.2} against contact-factorizations",
-                    ns[i - 1],
-                    ns[i],
-                    growth_exponent(&cs[i - 1..=i], &walls[i - 1..=i]),
-                    growth_exponent(&cf[i - 1..=i], &walls[i - 1..=i])
-                )
-            })
-            .collect();
-        println!("Between consecutive sizes: {}.", segments.join("; "));
     }
     Ok(())
 }

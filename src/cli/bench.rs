@@ -27,6 +27,10 @@ pub struct BenchArgs {
     /// Simulated time of the scaling runs, s.
     #[arg(long, default_value_t = 2.0, allow_negative_numbers = true)]
     pub scaling_duration: f64,
+    /// Wall sizes timed on one thread and on the whole pool, standing and struck (comma
+    /// separated, each 1..=99998; empty: no such table).
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "100", allow_negative_numbers = true)]
+    pub thread_sizes: Vec<usize>,
     /// Rock-mass cutting: boxes cut by three joint sets into about this many blocks (comma
     /// separated, each 1..=100000).
     #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "1000,10000", allow_negative_numbers = true)]
@@ -56,6 +60,10 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
         args.scaling_duration,
     )
     .map_err(CliError::Run)?;
+    if !args.thread_sizes.is_empty() {
+        crate::bench::thread_table(&args.thread_sizes, args.scaling_duration)
+            .map_err(CliError::Run)?;
+    }
     if !args.cut_sizes.is_empty() {
         crate::bench::cut_table(&args.cut_sizes, args.repeat).map_err(CliError::Run)?;
     }
@@ -69,6 +77,7 @@ fn check_options(args: &BenchArgs) -> Result<(), String> {
     for (flag, sizes) in [
         ("--sizes", &args.sizes),
         ("--standing-sizes", &args.standing_sizes),
+        ("--thread-sizes", &args.thread_sizes),
     ] {
         if let Some(n) = sizes.iter().find(|n| !(1..=MAX_WALL_BLOCKS).contains(n)) {
             return Err(format!(

@@ -9,6 +9,7 @@ use rayon::prelude::*;
 use super::active::Active;
 use super::counters::debug_log;
 use super::step_control::max_step_penetration;
+use super::{PAR_CONTACTS, PAR_PAIRS};
 use crate::contact::detection::detect_pair;
 use crate::contact::groups::{Bounds, ContactGroups};
 use crate::contact::joint::joint_set;
@@ -39,7 +40,7 @@ pub(crate) struct ActivationInputs<'a> {
 /// other (the broad phase's pairs, sorted).
 pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let p = inp.params;
-    let shapes: Vec<Shape> = inp.blocks.par_iter().map(Shape::of).collect();
+    let shapes: Vec<Shape> = inp.blocks.iter().map(Shape::of).collect();
     let bounds = inp
         .blocks
         .iter()
@@ -52,6 +53,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let cands: Vec<Candidate> = groups
         .pairs
         .par_iter()
+        .with_min_len(PAR_PAIRS)
         .flat_map_iter(|&(a, b)| {
             let dp = DetectionParams {
                 check_crossing_depth: p.method == Method::Alm,
@@ -70,6 +72,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     }
     let (mut active, new): (Vec<Active>, Vec<bool>) = cands
         .into_par_iter()
+        .with_min_len(PAR_CONTACTS)
         .map(|cand| {
             let w0 = groups.group_w0(cand.key.i as usize);
             activate_one(inp, &by_vertex, cand, w0)

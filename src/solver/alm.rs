@@ -5,6 +5,7 @@
 
 use rayon::prelude::*;
 
+use super::PAR_CONTACTS;
 use super::active::Active;
 use super::assemble::{StiffnessSync, load_vector};
 use super::counters::{Counters, Stopwatch};
@@ -143,6 +144,7 @@ fn measure(p: &SolverParams, d: &[f64], active: &mut [Active]) -> (bool, bool) {
     // they do not depend on the thread count.
     let terms: Vec<(bool, f64, f64)> = active
         .par_iter_mut()
+        .with_min_len(PAR_CONTACTS)
         .map(|c| {
             let (di, dj) = c.increments(d);
             c.dn = c.kin.penetration(&di, &dj);
@@ -184,6 +186,7 @@ fn update_multipliers(
     // Each contact on its own, in parallel.
     active
         .par_iter_mut()
+        .with_min_len(PAR_CONTACTS)
         .map(|c| {
             if c.rec.state == ContactState::Open {
                 return false;
@@ -229,6 +232,7 @@ fn tangential_slip(c: &Active, d: &[f64], blocks: &[Block]) -> crate::physics::g
 fn stuck(inp: &AlmInputs, d: &[f64], active: &[Active]) -> bool {
     active
         .par_iter()
+        .with_min_len(PAR_CONTACTS)
         .filter(|c| c.rec.state == ContactState::Lock)
         .all(|c| {
             tangential_slip(c, d, inp.blocks).norm()
@@ -251,15 +255,18 @@ fn stuck(inp: &AlmInputs, d: &[f64], active: &[Active]) -> bool {
 /// with 0.12 mm of slip; with f0·w0 in every step, a struck wall of 100 blocks needed 158 solves
 /// a step instead of 99 (57 with no stick update).
 fn absorb_stick_slip(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
-    active.par_iter_mut().for_each(|c| {
-        if c.rec.state == ContactState::Lock {
-            let slip = tangential_slip(c, d, inp.blocks);
-            c.rec.reference -= slip;
-            if !inp.params.joints_held && !inp.first_step {
-                c.cap_shear(inp.params);
+    active
+        .par_iter_mut()
+        .with_min_len(PAR_CONTACTS)
+        .for_each(|c| {
+            if c.rec.state == ContactState::Lock {
+                let slip = tangential_slip(c, d, inp.blocks);
+                c.rec.reference -= slip;
+                if !inp.params.joints_held && !inp.first_step {
+                    c.cap_shear(inp.params);
+                }
             }
-        }
-    });
+        });
 }
 
 /// A sliding contact whose slip has reversed is in the wrong state, and its friction, from
@@ -269,13 +276,16 @@ fn absorb_stick_slip(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
 /// from that solution. The friction of such a contact is held at its present value for the rest
 /// of the pass (a change of F only: no refactorization); the open–close check locks it.
 fn hold_reversed_friction(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
-    active.par_iter_mut().for_each(|c| {
-        if c.rec.state != ContactState::Slide || c.frozen || c.friction_cap.is_some() {
-            return;
-        }
-        let du = c.relative_displacement(d, inp.blocks);
-        if law::reversed(&du, &c.rec.tau, c.slip_tolerance(inp.params)) {
-            c.friction_cap = Some(c.rec.lambda);
-        }
-    });
+    active
+        .par_iter_mut()
+        .with_min_len(PAR_CONTACTS)
+        .for_each(|c| {
+            if c.rec.state != ContactState::Slide || c.frozen || c.friction_cap.is_some() {
+                return;
+            }
+            let du = c.relative_displacement(d, inp.blocks);
+            if law::reversed(&du, &c.rec.tau, c.slip_tolerance(inp.params)) {
+                c.friction_cap = Some(c.rec.lambda);
+            }
+        });
 }

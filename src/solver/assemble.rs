@@ -4,6 +4,7 @@
 
 use rayon::prelude::*;
 
+use super::PAR_BLOCKS;
 use super::active::{Active, StiffnessKey};
 use crate::contact::ContactState;
 use crate::contact::kinematics::{
@@ -53,6 +54,7 @@ pub(crate) fn block_terms(
 ) -> (Vec<Mat12>, Vec<Vec12>) {
     blocks
         .par_iter()
+        .with_min_len(PAR_BLOCKS)
         .map(|b| {
             let t = one_block(p, b, scheme, &b.kinematics(), dt);
             (t.k, t.f)

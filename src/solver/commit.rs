@@ -8,6 +8,7 @@ use nalgebra::Vector6;
 use rayon::prelude::*;
 
 use super::active::Active;
+use super::{PAR_BLOCKS, PAR_CONTACTS};
 use crate::contact::record::ContactRecord;
 use crate::contact::{ContactKey, ContactState};
 use crate::model::Block;
@@ -21,6 +22,7 @@ use crate::snapshot::{ContactSnapshot, StepStats};
 pub(crate) fn step_maps(blocks: &[Block], d: &[f64]) -> Vec<StepMap> {
     blocks
         .par_iter()
+        .with_min_len(PAR_BLOCKS)
         .enumerate()
         .map(|(i, b)| {
             let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
@@ -39,6 +41,7 @@ pub(crate) fn commit_contacts(
     // Each contact's record and snapshot in parallel, gathered in the contacts' order.
     let committed: Vec<(ContactKey, ContactRecord, Option<ContactSnapshot>)> = active
         .par_iter()
+        .with_min_len(PAR_CONTACTS)
         .map(|c| commit_contact(p, maps, c))
         .collect();
     let mut contacts = Vec::new();
@@ -119,26 +122,30 @@ pub(crate) fn commit_blocks(
     dt: f64,
     scheme: &Scheme,
 ) {
-    blocks.par_iter_mut().enumerate().for_each(|(i, b)| {
-        let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
-        b.set_kinematics(scheme.advance(&b.kinematics(), &di, dt));
-        let de = di.fixed_rows::<6>(6).into_owned();
-        let map = &maps[i];
-        if p.rotate_stress {
-            b.stress = rotate_stress(&b.stress, map.rotation());
-        }
-        b.stress += b.elasticity * de;
-        b.strain += de;
-        for v in &mut b.vertices {
-            *v = map.apply(v);
-        }
-        // Point loads are dead loads: the point moves with the block, the force keeps its
-        // direction in space (as in Shi's code).
-        for (pt, _) in &mut b.loads {
-            *pt = map.apply(pt);
-        }
-        b.refresh();
-    });
+    blocks
+        .par_iter_mut()
+        .with_min_len(PAR_BLOCKS)
+        .enumerate()
+        .for_each(|(i, b)| {
+            let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
+            b.set_kinematics(scheme.advance(&b.kinematics(), &di, dt));
+            let de = di.fixed_rows::<6>(6).into_owned();
+            let map = &maps[i];
+            if p.rotate_stress {
+                b.stress = rotate_stress(&b.stress, map.rotation());
+            }
+            b.stress += b.elasticity * de;
+            b.strain += de;
+            for v in &mut b.vertices {
+                *v = map.apply(v);
+            }
+            // Point loads are dead loads: the point moves with the block, the force keeps its
+            // direction in space (as in Shi's code).
+            for (pt, _) in &mut b.loads {
+                *pt = map.apply(pt);
+            }
+            b.refresh();
+        });
 }
 
 /// The step's statistics from its contacts: the largest penetration and kept overlap of a

@@ -5,6 +5,7 @@
 
 use rayon::prelude::*;
 
+use super::PAR_CONTACTS;
 use super::active::Active;
 use super::counters::{Counters, debug_log};
 use super::step_control::Retry;
@@ -51,6 +52,7 @@ pub(crate) fn check(
     } else {
         active
             .par_iter_mut()
+            .with_min_len(PAR_CONTACTS)
             .map(one)
             .reduce(|| (false, 0), |(a, n), (b, m)| (a || b, n + m))
     };
