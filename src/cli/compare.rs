@@ -401,7 +401,7 @@ mod tests {
             assert!(interval(Some(bad), None, 2.0).is_err(), "{bad}");
         }
         let e = interval(Some(1e-6), None, 2.0).unwrap_err();
-        assert!(e.message().contains("more than 1e5"), "{}", e.message());
+        assert!(e.message().contains("more than 100000"), "{}", e.message());
     }
 
     #[test]
