@@ -13,7 +13,7 @@
 //! - [`slope`]: scenes with a closed form (one free block on one fixed slope), recognised from
 //!   their geometry;
 //! - [`tables`]: the paper's Table 1 (standing block) and Table 2 (sliding block);
-//! - [`report`]: `compare.json`.
+//! - [`report`]: the file `compare.json`.
 //!
 //! Data flow: the compare module reads the solver (a model's masses, for the closed forms),
 //! snapshots and parameters; it writes no file and knows no front end.

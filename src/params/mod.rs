@@ -587,8 +587,10 @@ mod tests {
     /// comparison use them), and is found by its name, its key and its flag spelling.
     #[test]
     fn every_key_reads_back_its_own_text() {
-        let mut p = SolverParams::default();
-        p.method = Method::Penalty;
+        let mut p = SolverParams {
+            method: Method::Penalty,
+            ..SolverParams::default()
+        };
         p.contact.eps1 = 0.012_345_678_9;
         p.spectral_radius = 1.0 / 3.0;
         p.gravity = [0.1, 0.0, -9.81];
