@@ -13,7 +13,8 @@
 //!                        │  uses physics (geometry, mechanics, linear) and contact
 //!                        ▼
 //!                     snapshot ──▶ output (CSV, JSON)
-//!                              └─▶ render (wgpu) ──▶ viewer (egui, winit)
+//!                              ├─▶ render (wgpu) ──▶ viewer (egui, winit)
+//!                              └─▶ compare (two runs side by side, the paper's tables)
 //! ```
 //!
 //! [`params`] holds every tunable; [`cli`] is the binary's front end, [`generate`] and [`bench`]
@@ -21,6 +22,7 @@
 
 pub mod bench;
 pub mod cli;
+pub mod compare;
 pub mod contact;
 pub mod generate;
 pub mod model;

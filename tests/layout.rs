@@ -1,6 +1,6 @@
 //! The architecture, checked: file and function sizes, and the direction of the data flow
-//! scene → model → solver → snapshot → render / output (README "Layout"). A module that reaches
-//! against the flow fails here with the file and the import.
+//! scene → model → solver → snapshot → render / output / compare (README "Layout"). A module
+//! that reaches against the flow fails here with the file and the import.
 
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -116,6 +116,7 @@ const FRONT: &[&str] = &[
     "crate::viewer",
     "crate::cli",
     "crate::output",
+    "crate::compare",
 ];
 /// The run's machinery, which the snapshot hides from the front ends.
 const ENGINE: &[&str] = &[
@@ -174,6 +175,24 @@ const FORBIDDEN: &[(&str, &[&str], &[&str])] = &[
         "src/render/",
         &["crate::viewer", "crate::cli", "crate::output"],
         ENGINE,
+    ),
+    // Two runs compared: the solver (a model's masses), its snapshots and the parameters, and
+    // nothing of the files, the pictures or the command line, so the viewer and `render` can
+    // use it as `run` does.
+    (
+        "src/compare/",
+        &[
+            "crate::render",
+            "crate::viewer",
+            "crate::cli",
+            "crate::output",
+        ],
+        &[
+            "crate::contact",
+            "crate::model",
+            "crate::physics",
+            "crate::scene",
+        ],
     ),
     // The viewer is driven by the command line, never the other way round.
     ("src/viewer/", &["crate::cli"], &[]),

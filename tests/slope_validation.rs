@@ -1,8 +1,12 @@
 //! The paper's §3.1 validation: Table 1 (block resting on a 30° slope, static mode) and Table 2
-//! (block sliding down it, dynamic mode), for DDA-3a (ALM) and DDA-3p (penalty).
+//! (block sliding down it, dynamic mode), for DDA-3a (ALM) and DDA-3p (penalty). The closed
+//! forms are the paper's, written out here; `dda3d::compare`'s (what `run --compare` writes to
+//! compare.json) must agree with them.
 
 use std::path::Path;
 
+use dda3d::compare::slope::{self, Motion};
+use dda3d::compare::tables;
 use dda3d::params::Method;
 use dda3d::scene;
 use dda3d::snapshot::ContactState;
@@ -34,10 +38,24 @@ struct Table1 {
     /// (along-slope position of the contact point, normal force, penetration, penalty, λ)
     contacts: Vec<(f64, f64, f64, f64, f64)>,
     drift: f64,
+    /// The library's table of the same state.
+    table: tables::StandingTable,
+}
+
+/// The library's closed form of a slope scene agrees with the paper's geometry.
+fn closed_form(s: &Solver, motion: Motion) -> slope::SlopeCase {
+    let case = slope::of_solver(s).expect("a slope with a closed form");
+    assert_eq!(case.motion, motion);
+    assert!((case.theta_deg - THETA).abs() < 1e-9);
+    let d = downslope();
+    assert!((0..3).all(|k| (case.downslope[k] - d[k]).abs() < 1e-12));
+    assert!((case.weight - 2750.0 * 8.0 * 9.8).abs() < 1e-6);
+    case
 }
 
 fn run_table1(method: Method) -> Table1 {
     let mut s = solver("slope_stable.toml", method);
+    let case = closed_form(&s, Motion::Stands);
     while !s.finished() {
         s.step().expect("no divergence");
     }
@@ -66,6 +84,7 @@ fn run_table1(method: Method) -> Table1 {
     Table1 {
         contacts,
         drift: dot(d, d).sqrt(),
+        table: tables::standing(&case, &snap),
     }
 }
 
@@ -134,6 +153,16 @@ fn table1_stable_block_contact_forces() {
             }
         }
         assert!(t.drift < 1e-3, "{method:?}: the block crept {} m", t.drift);
+        // compare.json's Table 1: the same forces against the same (P25).
+        assert_eq!(t.table.contacts.len(), 4);
+        for row in &t.table.contacts {
+            let theory = if row.along_slope < 0.0 { n_up } else { n_down };
+            assert!(
+                (row.theory.unwrap() - theory).abs() < 1e-6 * theory,
+                "{row:?}"
+            );
+        }
+        assert!(t.table.normal_error_percent < 1e-6 && t.table.drift == t.drift);
         worst.insert(format!("{method:?}"), err_max);
     }
     println!(
@@ -152,6 +181,8 @@ fn table2_sliding_block_displacement() {
     let th = THETA.to_radians();
     let phi = 15f64.to_radians();
     let acc = 0.5 * (th.sin() - th.cos() * phi.tan()) * 9.8;
+    let case = closed_form(&solver("slope_sliding.toml", Method::Alm), Motion::Slides);
+    assert!((0.5 * case.acceleration - acc).abs() < 1e-12);
     // The paper's DDA-3a relative errors (%), the bar every row must meet.
     let paper_3a = [0.34, 0.20, 0.13, 0.09, 0.07, 0.06, 0.05, 0.08, 0.07, 0.02];
     let paper_3p = [17.26, 6.95, 5.29, 4.20, 3.58, 3.08, 2.59, 2.28, 2.01, 1.77];

@@ -9,6 +9,7 @@
 //! line is a contract: flags, defaults, help texts and exit statuses stay as they are.
 
 mod bench;
+mod compare;
 mod cut;
 pub mod exit;
 mod generate;

@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
+use super::compare::{self, CompareArgs};
 use super::exit::{self, Failure, Signal};
 use super::resume::{self, Checkpoints};
 use super::{CliError, SolverOverrides, load_scene};
@@ -51,6 +52,8 @@ pub struct RunArgs {
         conflicts_with_all = ["scene", "method", "mode", "spectral_radius", "max_time_step", "initial_equilibrium"]
     )]
     pub resume: Option<PathBuf>,
+    #[command(flatten)]
+    pub compare: CompareArgs,
     /// Also write the ParaView series into OUT/vtk/ (blocks as polyhedra, contacts as points,
     /// .pvd collections with simulated time); the scene's `[output] vtk = true`
     #[arg(long)]
@@ -117,7 +120,11 @@ impl Progress {
 /// Runs the initial equilibrium stage, if the scene has one, and says how it ended: an
 /// unconverged stage is a warning (a block the stage could not bring to rest), not an error.
 /// A stop signal ends the stage early (`Ok(Some(signal))`).
-fn settle(solver: &mut Solver, scene: &Path, quiet: bool) -> Result<Option<Signal>, SolverError> {
+pub(super) fn settle(
+    solver: &mut Solver,
+    scene: &Path,
+    quiet: bool,
+) -> Result<Option<Signal>, SolverError> {
     // A run resumed after its stage said how the stage ended the first time.
     if !solver.in_equilibrium_stage() && solver.time > 0.0 {
         return Ok(None);
@@ -148,12 +155,24 @@ fn settle(solver: &mut Solver, scene: &Path, quiet: bool) -> Result<Option<Signa
     Ok(None)
 }
 
+impl End {
+    /// summary.json's `status` and `error`.
+    pub(super) fn status(&self) -> (&'static str, Option<String>) {
+        match self {
+            End::Completed => ("completed", None),
+            End::Diverged(e) => ("diverged", Some(e.to_string())),
+            End::Interrupted(s) => ("interrupted", Some(format!("stopped by {}", s.name()))),
+            End::Io(e) => ("io_error", Some(e.to_string())),
+        }
+    }
+}
+
 /// How often, in wall time, a run commits its CSV rows and rewrites summary.json as
 /// "running": what a kill -9 can lose.
 const CHECKPOINT: Duration = Duration::from_secs(1);
 
 /// How a run ended.
-enum End {
+pub(super) enum End {
     Completed,
     Diverged(SolverError),
     Interrupted(Signal),
@@ -162,7 +181,7 @@ enum End {
 
 /// The outputs of a run as it goes: rows every step, and at every [`CHECKPOINT`] both CSV
 /// files committed to the same step and summary.json rewritten as "running".
-struct Record<'a> {
+pub(super) struct Record<'a> {
     writer: RunWriter,
     /// The ParaView series, if asked for.
     vtk: Option<VtkWriter>,
@@ -176,7 +195,35 @@ struct Record<'a> {
     states: Checkpoints,
 }
 
-impl Record<'_> {
+impl<'a> Record<'a> {
+    /// The outputs of `solver`'s run in `out`: the CSV files, the VTK series when `vtk` gives
+    /// its interval (`Some(None)`: every step), and the checkpoints every `every`.
+    pub(super) fn create(
+        out: &Path,
+        solver: &Solver,
+        scene: &'a str,
+        rock_masses: Vec<RockMassReport>,
+        vtk: Option<Option<f64>>,
+        every: Option<f64>,
+    ) -> Result<Self, Failure> {
+        let writer = RunWriter::create(out).map_err(|e| Failure::Io(e.to_string()))?;
+        let vtk = vtk
+            .map(|interval| VtkWriter::create(out, interval))
+            .transpose()
+            .map_err(|e| Failure::Io(e.to_string()))?;
+        Ok(Record {
+            writer,
+            vtk,
+            scene,
+            rock_masses,
+            method: solver.params.method,
+            mode: solver.params.mode,
+            start: Instant::now(),
+            last_checkpoint: Instant::now(),
+            states: Checkpoints::new(every, solver.time),
+        })
+    }
+
     fn summary(&self, solver: &Solver, status: &str) -> Summary {
         let wall = self.start.elapsed().as_secs_f64();
         let (method, mode) = (self.method.as_str(), self.mode.as_str());
@@ -189,8 +236,13 @@ impl Record<'_> {
     }
 
     /// Rows of the step just completed, and a checkpoint when one is due.
-    fn step(&mut self, solver: &Solver) -> Result<(), OutputError> {
-        self.write(&solver.snapshot())?;
+    pub(super) fn step(&mut self, solver: &Solver) -> Result<(), OutputError> {
+        self.step_with(solver, &solver.snapshot())
+    }
+
+    /// [`Record::step`] with the solver's snapshot taken already.
+    pub(super) fn step_with(&mut self, solver: &Solver, s: &Snapshot) -> Result<(), OutputError> {
+        self.write(s)?;
         self.states.after_step(solver, self.writer.dir())?;
         if self.last_checkpoint.elapsed() >= CHECKPOINT {
             self.checkpoint(solver)?;
@@ -199,7 +251,7 @@ impl Record<'_> {
     }
 
     /// The rows of a state, and its VTK files when an output is due.
-    fn write(&mut self, s: &Snapshot) -> Result<(), OutputError> {
+    pub(super) fn write(&mut self, s: &Snapshot) -> Result<(), OutputError> {
         self.writer.write(s)?;
         match &mut self.vtk {
             Some(vtk) => vtk.step(s),
@@ -207,21 +259,34 @@ impl Record<'_> {
         }
     }
 
-    fn checkpoint(&mut self, solver: &Solver) -> Result<(), OutputError> {
+    pub(super) fn checkpoint(&mut self, solver: &Solver) -> Result<(), OutputError> {
         self.writer.commit()?;
         self.summary(solver, "running").write(self.writer.dir())?;
         self.last_checkpoint = Instant::now();
         Ok(())
     }
 
+    /// The last rows (and VTK files), then the final summary.json. If the rows cannot be
+    /// written, that is what the summary reports: the files stop short of the state the run
+    /// reached. Returns how the run ended after all, and whether the summary was written.
+    pub(super) fn close(
+        &mut self,
+        solver: &Solver,
+        mut end: End,
+    ) -> (End, Result<(), OutputError>) {
+        if !matches!(end, End::Io(_)) {
+            let last = self.vtk.as_mut().map(|v| v.finish(&solver.snapshot()));
+            if let Err(e) = self.writer.commit().and(last.unwrap_or(Ok(()))) {
+                end = End::Io(e);
+            }
+        }
+        let saved = self.finish(solver, &end);
+        (end, saved)
+    }
+
     /// The final summary.json (the rows are committed by then).
     fn finish(&mut self, solver: &Solver, end: &End) -> Result<(), OutputError> {
-        let (status, error) = match end {
-            End::Completed => ("completed", None),
-            End::Diverged(e) => ("diverged", Some(e.to_string())),
-            End::Interrupted(s) => ("interrupted", Some(format!("stopped by {}", s.name()))),
-            End::Io(e) => ("io_error", Some(e.to_string())),
-        };
+        let (status, error) = end.status();
         let mut summary = self.summary(solver, status);
         summary.error = error;
         summary.write(self.writer.dir()).map(|_| ())
@@ -260,54 +325,49 @@ fn advance(solver: &mut Solver, rec: &mut Record, args: &RunArgs) -> End {
     end.unwrap_or_else(End::Io)
 }
 
-/// `dda3d run`, with its failures as [`Failure`]s (their exit statuses). Bad input is
-/// reported before any file is created.
-pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
+/// The flags of the outputs that can be checked before the scene is read: the interval of
+/// `--checkpoint-every`, which it returns, and of `--output-interval`.
+pub(super) fn output_flags(args: &RunArgs) -> Result<Option<f64>, Failure> {
     let every = resume::interval(args.checkpoint_every)?;
     if let Some(dt) = args.output_interval {
         OutputSettings::check_interval(dt)
             .map_err(|m| Failure::Input(format!("--output-interval: {m}")))?;
     }
-    let (mut solver, rock_masses, output, default_out) = start(args)?;
-    let out = args.out.clone().unwrap_or(default_out);
+    Ok(every)
+}
+
+/// The VTK series a run writes, if any: `Some(interval)` (`Some(None)`: every step). An
+/// interval without the series is a mistake to say: the CSV files take every step.
+pub(super) fn vtk_output(
+    args: &RunArgs,
+    output: &OutputSettings,
+) -> Result<Option<Option<f64>>, Failure> {
     let write_vtk = args.vtk || output.vtk;
     if args.output_interval.is_some() && !write_vtk {
-        // The CSV files take every step; an interval that changes nothing is a mistake to say.
         return Err(Failure::Input(
             "--output-interval sets the VTK output's interval: add --vtk (or [output] vtk = \
              true in the scene)"
                 .into(),
         ));
     }
-    exit::catch_stop_signals()?;
-    let writer = RunWriter::create(&out).map_err(|e| Failure::Io(e.to_string()))?;
-    let interval = args.output_interval.or(output.interval);
-    let vtk = write_vtk
-        .then(|| VtkWriter::create(&out, interval))
-        .transpose()
-        .map_err(|e| Failure::Io(e.to_string()))?;
-    let name = solver.model.name.clone();
-    let mut rec = Record {
-        writer,
-        vtk,
-        scene: &name,
-        rock_masses,
-        method: solver.params.method,
-        mode: solver.params.mode,
-        start: Instant::now(),
-        last_checkpoint: Instant::now(),
-        states: Checkpoints::new(every, solver.time),
-    };
-    let mut end = advance(&mut solver, &mut rec, args);
-    if !matches!(end, End::Io(_)) {
-        // The last rows (and VTK files). If they cannot be written, that is what the summary
-        // reports: the files stop short of the state the run reached.
-        let last = rec.vtk.as_mut().map(|v| v.finish(&solver.snapshot()));
-        if let Err(e) = rec.writer.commit().and(last.unwrap_or(Ok(()))) {
-            end = End::Io(e);
-        }
+    Ok(write_vtk.then_some(args.output_interval.or(output.interval)))
+}
+
+/// `dda3d run`, with its failures as [`Failure`]s (their exit statuses). Bad input is
+/// reported before any file is created.
+pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
+    if let Some(spec) = compare::spec(&args.compare)? {
+        return compare::execute(args, &spec);
     }
-    let saved = rec.finish(&solver, &end);
+    let every = output_flags(args)?;
+    let (mut solver, rock_masses, output, default_out) = start(args)?;
+    let out = args.out.clone().unwrap_or(default_out);
+    let vtk = vtk_output(args, &output)?;
+    exit::catch_stop_signals()?;
+    let name = solver.model.name.clone();
+    let mut rec = Record::create(&out, &solver, &name, rock_masses, vtk, every)?;
+    let end = advance(&mut solver, &mut rec, args);
+    let (end, saved) = rec.close(&solver, end);
     report(&solver, &rec, end, saved, args)
 }
 

@@ -583,6 +583,37 @@ mod tests {
         );
     }
 
+    /// Every key reads back the text it writes (as `--compare-set` and the labels of a
+    /// comparison use them), and is found by its name, its key and its flag spelling.
+    #[test]
+    fn every_key_reads_back_its_own_text() {
+        let mut p = SolverParams {
+            method: Method::Penalty,
+            ..SolverParams::default()
+        };
+        p.contact.eps1 = 0.012_345_678_9;
+        p.spectral_radius = 1.0 / 3.0;
+        p.gravity = [0.1, 0.0, -9.81];
+        p.contact.warm_start = false;
+        p.contact.max_alm_iterations = 7;
+        p.contact.initial_penalty = 2e9;
+        for k in ALL {
+            let text = k.text(&p);
+            let mut q = SolverParams::default();
+            (k.set)(&mut q, &text).unwrap_or_else(|e| panic!("{}: {text}: {e}", k.key));
+            assert_eq!((k.get)(&q), (k.get)(&p), "{}: {text}", k.key);
+            assert_eq!(find(k.name()).map(|f| f.key), Some(k.key));
+            assert_eq!(find(k.key).map(|f| f.key), Some(k.key));
+            assert_eq!(
+                find(&k.name().replace('_', "-")).map(|f| f.key),
+                Some(k.key)
+            );
+        }
+        assert_eq!(INITIAL_PENALTY.text(&p), "2e9");
+        assert_eq!(EPS1.text(&p), "1.23456789e-2");
+        assert!(find("nonsense").is_none());
+    }
+
     /// Keys the README's scene table does not have yet.
     #[test]
     fn the_readme_documents_every_key() {

@@ -16,9 +16,11 @@ use crate::text::short;
 
 pub mod contact_keys;
 pub mod solver_keys;
+pub mod text;
 
 pub use contact_keys::*;
 pub use solver_keys::*;
+pub use text::{FromText, assign};
 
 /// A value of any kind of tunable, as read from [`SolverParams`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -143,6 +145,10 @@ pub struct Param {
     doc: &'static str,
     pub default: Value,
     pub get: fn(&SolverParams) -> Value,
+    /// Sets the key from text (`2e9`, `true`, `penalty`, `[0, 0, -9.8]`; see [`text`]): an
+    /// error says what kind of value was expected. The range is not checked here: that is
+    /// [`SolverParams::check`]'s, as for the scene file.
+    pub set: fn(&mut SolverParams, &str) -> Result<(), String>,
     /// The values [`SolverParams::validate`] accepts, for numbers.
     pub valid: Interval,
     /// Why the valid range ends where it does, for a range narrower than the sign alone ("" for
@@ -152,10 +158,51 @@ pub struct Param {
     pub widget: Option<Widget>,
 }
 
+/// A key is its entry: shown and compared by its key alone (the entry holds functions).
+impl std::fmt::Debug for Param {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_tuple("Param").field(&self.key).finish()
+    }
+}
+
+impl PartialEq for Param {
+    fn eq(&self, other: &Self) -> bool {
+        self.key == other.key
+    }
+}
+
 impl Param {
     /// The scene-file key without its table: `beta`.
     pub fn name(&self) -> &'static str {
         self.key.rsplit('.').next().unwrap_or(self.key)
+    }
+
+    /// Whether `name` names this key: its scene-file name (`eps1`), the key with its table
+    /// (`solver.contact.eps1`), or the name with dashes as a flag writes it
+    /// (`max-time-step`).
+    pub fn is_named(&self, name: &str) -> bool {
+        let name = name.replace('-', "_");
+        name == self.name() || name == self.key
+    }
+
+    /// The value as text that [`Param::set`] reads back to the same value: numbers in their
+    /// short form where that is exact (`2e9`, `0.01`), else in full.
+    pub fn text(&self, params: &SolverParams) -> String {
+        let real = |x: f64| {
+            let s = short(x);
+            if s.parse() == Ok(x) {
+                s
+            } else {
+                format!("{x:e}")
+            }
+        };
+        match (self.get)(params) {
+            Value::Real(x) => real(x),
+            Value::Count(n) => n.to_string(),
+            Value::Vector(v) => format!("[{}]", v.map(real).join(", ")),
+            Value::Flag(b) => b.to_string(),
+            Value::Choice(s) => s.to_owned(),
+        }
     }
 
     /// The scene-file table that holds the key: `solver.contact`.
@@ -356,6 +403,11 @@ const fn absolute(lo: f64, hi: f64, logarithmic: bool) -> Option<Widget> {
         range: WidgetRange::Absolute(lo, hi),
         logarithmic,
     })
+}
+
+/// The entry `name` names (see [`Param::is_named`]).
+pub fn find(name: &str) -> Option<&'static Param> {
+    ALL.iter().copied().find(|p| p.is_named(name))
 }
 
 /// Every key, in the scene file's order (`[solver]`, `[solver.contact]`, `[joint]`).

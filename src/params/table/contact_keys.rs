@@ -1,6 +1,6 @@
 //! The `[solver.contact]` and `[joint]` keys of the parameter table (see [`super`]).
 
-use super::{Bound, Interval, Param, Value, Widget, WidgetRange, absolute};
+use super::{Bound, Interval, Param, Value, Widget, WidgetRange, absolute, assign};
 
 pub const INITIAL_PENALTY: Param = Param {
     key: "solver.contact.initial_penalty",
@@ -11,6 +11,7 @@ pub const INITIAL_PENALTY: Param = Param {
           small.",
     default: Value::Real(2.0e8),
     get: |p| Value::Real(p.contact.initial_penalty),
+    set: |p, text| assign(text, &mut p.contact.initial_penalty),
     valid: Interval::POSITIVE,
     valid_why: "",
     widget: Some(Widget {
@@ -27,6 +28,7 @@ pub const ALPHA: Param = Param {
           whose penetration does not shrink fast enough). Paper: α = 10.",
     default: Value::Real(10.0),
     get: |p| Value::Real(p.contact.alpha),
+    set: |p, text| assign(text, &mut p.contact.alpha),
     valid: Interval::new(Bound::Open(1.0), Bound::Unbounded),
     valid_why: "",
     widget: absolute(1.01, 1000.0, true),
@@ -40,6 +42,7 @@ pub const BETA: Param = Param {
           |d_n,k| > β·|d_n,k−1|. Paper: β = 0.25.",
     default: Value::Real(0.25),
     get: |p| Value::Real(p.contact.beta),
+    set: |p, text| assign(text, &mut p.contact.beta),
     valid: Interval::new(Bound::Open(0.0), Bound::Open(1.0)),
     valid_why: "",
     widget: absolute(0.01, 0.99, false),
@@ -53,6 +56,7 @@ pub const GAMMA: Param = Param {
           like p·Δt²/m).",
     default: Value::Real(100.0),
     get: |p| Value::Real(p.contact.gamma),
+    set: |p, text| assign(text, &mut p.contact.gamma),
     valid: Interval::POSITIVE,
     valid_why: "",
     widget: absolute(0.01, 1000.0, true),
@@ -67,6 +71,7 @@ pub const EPS1: Param = Param {
           uses 0.01.",
     default: Value::Real(0.01),
     get: |p| Value::Real(p.contact.eps1),
+    set: |p, text| assign(text, &mut p.contact.eps1),
     valid: Interval::new(Bound::Open(0.0), Bound::Open(1.0)),
     valid_why: "ε1 ≥ 1 would accept a penetration as deep as the whole contact window d_n,max, \
           beyond which a contact is not found at all.",
@@ -82,6 +87,7 @@ pub const EPS2: Param = Param {
           uses 0.01.",
     default: Value::Real(0.01),
     get: |p| Value::Real(p.contact.eps2),
+    set: |p, text| assign(text, &mut p.contact.eps2),
     valid: Interval::new(Bound::Open(0.0), Bound::Open(1.0)),
     valid_why: "ε2 ≥ 1 would take a 100 % change of the contact forces between two iterations for \
           convergence.",
@@ -96,6 +102,7 @@ pub const SHEAR_PENALTY_RATIO: Param = Param {
           code uses p_n / 2.5.",
     default: Value::Real(1.0 / 2.5),
     get: |p| Value::Real(p.contact.shear_penalty_ratio),
+    set: |p, text| assign(text, &mut p.contact.shear_penalty_ratio),
     valid: Interval::POSITIVE,
     valid_why: "",
     widget: absolute(0.01, 10.0, true),
@@ -109,6 +116,7 @@ pub const MAX_ALM_ITERATIONS: Param = Param {
           reference notes' suggestion).",
     default: Value::Count(20),
     get: |p| Value::Count(p.contact.max_alm_iterations),
+    set: |p, text| assign(text, &mut p.contact.max_alm_iterations),
     valid: Interval::new(Bound::Closed(1.0), Bound::Closed(1000.0)),
     valid_why: "each iteration is a linear solve and the paper's ALM converges in a few; the cap \
           bounds the cost of a pass that does not converge.",
@@ -124,6 +132,7 @@ pub const MAX_OPEN_CLOSE_ITERATIONS: Param = Param {
           change then, they are settled closed and locked instead.",
     default: Value::Count(30),
     get: |p| Value::Count(p.contact.max_open_close_iterations),
+    set: |p, text| assign(text, &mut p.contact.max_open_close_iterations),
     valid: Interval::new(Bound::Closed(1.0), Bound::Closed(1000.0)),
     valid_why: "each pass solves at least once; Shi uses 8, a struck wall 25, and a step still \
           changing after 1000 is redone with a shorter Δt anyway.",
@@ -138,6 +147,7 @@ pub const WARM_START: Param = Param {
           both converge to the same forces, warm starting in fewer iterations.",
     default: Value::Flag(true),
     get: |p| Value::Flag(p.contact.warm_start),
+    set: |p, text| assign(text, &mut p.contact.warm_start),
     valid: Interval::ANY,
     valid_why: "",
     widget: None,
@@ -151,6 +161,7 @@ pub const CLOSE_THRESHOLD: Param = Param {
           open–close chatter: the role of Shi's s0).",
     default: Value::Real(2.0e-7),
     get: |p| Value::Real(p.contact.close_threshold),
+    set: |p, text| assign(text, &mut p.contact.close_threshold),
     valid: Interval::new(Bound::Closed(0.0), Bound::Closed(0.01)),
     valid_why: "Shi's s0 is 2·10⁻⁴; at 0.01 (the paper's δ) a contact would move as far as a \
           whole step may before its state changes.",
@@ -166,6 +177,7 @@ pub const OPEN_THRESHOLD: Param = Param {
           (Shi's f0; hysteresis for contacts that carry no load).",
     default: Value::Real(2.0e-7),
     get: |p| Value::Real(p.contact.open_threshold),
+    set: |p, text| assign(text, &mut p.contact.open_threshold),
     valid: Interval::new(Bound::Closed(0.0), Bound::Closed(0.01)),
     valid_why: "Shi's s0 is 2·10⁻⁴; at 0.01 (the paper's δ) a contact would move as far as a \
           whole step may before its state changes.",
@@ -180,6 +192,7 @@ pub const FRICTION_ANGLE: Param = Param {
           exceeds N·tan φ (+ cohesion). The paper's examples use 35°.",
     default: Value::Real(35.0),
     get: |p| Value::Real(p.joint.friction_angle),
+    set: |p, text| assign(text, &mut p.joint.friction_angle),
     valid: Interval::new(Bound::Closed(0.0), Bound::Open(90.0)),
     valid_why: "",
     widget: absolute(0.0, 89.0, false),
@@ -193,6 +206,7 @@ pub const COHESION: Param = Param {
           slid (Shi's rule): once broken a joint keeps only friction.",
     default: Value::Real(0.0),
     get: |p| Value::Real(p.joint.cohesion),
+    set: |p, text| assign(text, &mut p.joint.cohesion),
     valid: Interval::NON_NEGATIVE,
     valid_why: "",
     widget: absolute(0.0, 1e8, true),

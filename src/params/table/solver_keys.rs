@@ -1,6 +1,6 @@
 //! The `[solver]` keys of the parameter table (see [`super`]).
 
-use super::{Bound, Interval, Param, Value, absolute};
+use super::{Bound, Interval, Param, Value, absolute, assign};
 
 pub const METHOD: Param = Param {
     key: "solver.method",
@@ -13,6 +13,7 @@ pub const METHOD: Param = Param {
           DDA-3p: classic fixed penalty p_n = p_n,1; penetration ≈ N / p_n.",
     default: Value::Choice("alm"),
     get: |p| Value::Choice(p.method.as_str()),
+    set: |p, text| assign(text, &mut p.method),
     valid: Interval::ANY,
     valid_why: "",
     widget: None,
@@ -27,6 +28,7 @@ pub const MODE: Param = Param {
           (for stability checks).",
     default: Value::Choice("dynamic"),
     get: |p| Value::Choice(p.mode.as_str()),
+    set: |p, text| assign(text, &mut p.mode),
     valid: Interval::ANY,
     valid_why: "",
     widget: None,
@@ -44,6 +46,7 @@ pub const SPECTRAL_RADIUS: Param = Param {
           ignores it.",
     default: Value::Real(0.5),
     get: |p| Value::Real(p.spectral_radius),
+    set: |p, text| assign(text, &mut p.spectral_radius),
     valid: Interval::new(Bound::Closed(1.0 / 3.0), Bound::Closed(1.0)),
     valid_why: "",
     widget: absolute(1.0 / 3.0, 1.0, false),
@@ -57,6 +60,7 @@ pub const DURATION: Param = Param {
           continues past it.",
     default: Value::Real(2.0),
     get: |p| Value::Real(p.duration),
+    set: |p, text| assign(text, &mut p.duration),
     valid: Interval::new(Bound::Closed(1e-7), Bound::Closed(1e7)),
     valid_why: "at least the shortest Δt_max, so that every run takes a step (the solver counts a \
           run within 10⁻⁹·Δt_max of its end as finished: 10⁻¹² s \"completed\"with none); at most \
@@ -73,6 +77,7 @@ pub const MAX_TIME_STEP: Param = Param {
           open–close does not converge, and grow back by ≤ {DT_GROWTH}× per step. Paper: 0.01 s.",
     default: Value::Real(0.01),
     get: |p| Value::Real(p.max_time_step),
+    set: |p, text| assign(text, &mut p.max_time_step),
     valid: Interval::new(Bound::Closed(1e-7), Bound::Closed(1.0)),
     valid_why: "a P-wave crosses a millimetre of rock in 2·10⁻⁷ s, and the constant-strain blocks \
           of DDA resolve nothing faster; the step control cuts down to Δt_max / 100, which up to \
@@ -90,6 +95,7 @@ pub const MAX_DISPLACEMENT_RATIO: Param = Param {
           with a smaller Δt. It also sets d_n,max = 2·δ·w0 (P22). Paper: 0.01.",
     default: Value::Real(0.01),
     get: |p| Value::Real(p.max_displacement_ratio),
+    set: |p, text| assign(text, &mut p.max_displacement_ratio),
     valid: Interval::new(Bound::Closed(1e-7), Bound::Closed(0.1)),
     valid_why: "Shi advises 0.001–0.01. Above 0.1 a step may move a vertex a tenth of w0 and \
           contacts are searched 2·δ·w0 away, a tenth of the model's extent; below 10⁻⁷ a whole \
@@ -104,6 +110,7 @@ pub const GRAVITY: Param = Param {
     doc: "Gravity; z is up.",
     default: Value::Vector([0.0, 0.0, -9.8]),
     get: |p| Value::Vector(p.gravity),
+    set: |p, text| assign(text, &mut p.gravity),
     valid: Interval::ANY,
     valid_why: "",
     widget: None,
@@ -117,6 +124,7 @@ pub const FIXED_SPRING_FACTOR: Param = Param {
           paper uses 100 E).",
     default: Value::Real(100.0),
     get: |p| Value::Real(p.fixed_spring_factor),
+    set: |p, text| assign(text, &mut p.fixed_spring_factor),
     valid: Interval::POSITIVE,
     valid_why: "",
     widget: None,
@@ -131,6 +139,7 @@ pub const MAX_DISPLACEMENT_OVERSHOOT: Param = Param {
           (P22) assumes.",
     default: Value::Real(1.0),
     get: |p| Value::Real(p.max_displacement_overshoot),
+    set: |p, text| assign(text, &mut p.max_displacement_overshoot),
     valid: Interval::new(Bound::Closed(1.0), Bound::Unbounded),
     valid_why: "",
     widget: None,
@@ -144,6 +153,7 @@ pub const ROTATE_STRESS: Param = Param {
           DDA does not.",
     default: Value::Flag(false),
     get: |p| Value::Flag(p.rotate_stress),
+    set: |p, text| assign(text, &mut p.rotate_stress),
     valid: Interval::ANY,
     valid_why: "",
     widget: None,
@@ -160,6 +170,7 @@ pub const INITIAL_EQUILIBRIUM: Param = Param {
           initial velocity are held where they are during the stage.",
     default: Value::Flag(false),
     get: |p| Value::Flag(p.initial_equilibrium),
+    set: |p, text| assign(text, &mut p.initial_equilibrium),
     valid: Interval::ANY,
     valid_why: "",
     widget: None,
@@ -174,6 +185,7 @@ pub const EQUILIBRIUM_TOLERANCE: Param = Param {
           block's radius). 1e-5 is the usual equilibrium ratio of 3DEC and PFC.",
     default: Value::Real(1e-5),
     get: |p| Value::Real(p.equilibrium_tolerance),
+    set: |p, text| assign(text, &mut p.equilibrium_tolerance),
     valid: Interval::new(Bound::Open(0.0), Bound::Open(1.0)),
     valid_why: "",
     widget: None,
@@ -188,6 +200,7 @@ pub const EQUILIBRIUM_MAX_STEPS: Param = Param {
           summary.json reports it unconverged.",
     default: Value::Count(2000),
     get: |p| Value::Count(p.equilibrium_max_steps),
+    set: |p, text| assign(text, &mut p.equilibrium_max_steps),
     valid: Interval::new(Bound::Closed(1.0), Bound::Closed(1e6)),
     valid_why: "10⁶ static steps cost as much as a run of 10⁴ s at the paper's Δt; a stage that \
           has not settled by then has a mechanism (a block that slides), not a slow start.",
