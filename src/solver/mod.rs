@@ -46,9 +46,9 @@ use crate::physics::linear::{BlockMatrix, SparseCholesky};
 /// hand-over between threads costs microseconds, one contact's work a fraction of one. Loops run
 /// on the pool's threads (each step is taken on one of them, see [`Solver::step_until`]), so an
 /// unsplit loop costs nothing extra.
-const PAR_CONTACTS: usize = 512;
-const PAR_PAIRS: usize = 64;
-const PAR_BLOCKS: usize = 64;
+const PAR_CONTACTS: usize = 2048;
+const PAR_PAIRS: usize = 512;
+const PAR_BLOCKS: usize = 256;
 
 use crate::snapshot::{
     BlockSnapshot, ContactSnapshot, EquilibriumReport, RunTotals, Snapshot, StepStats,
