@@ -407,7 +407,15 @@ fn a_stack_of_slabs_on_a_joint_slides_as_one() {
 /// crept 0.4–1.5 mm in 0.5 s (the README says so).
 #[test]
 fn slabs_cut_by_a_cross_set_slide_as_one() {
-    for (dip, phi, layers, cross) in [(40.0f64, 30.0f64, 3, 75.0f64), (45.0, 35.0, 3, 75.0)] {
+    // Also measured (not held to these bounds yet): four slabs cut at 80° travel within 1.6 %;
+    // three on 40°/φ 25° cut at 75° within 5 %; with a 65° cross set one block at the end of the
+    // stack falls almost freely (9.2 m/s²).
+    for (dip, phi, layers, cross) in [
+        (40.0f64, 30.0f64, 3, 75.0f64),
+        (45.0, 35.0, 3, 75.0),
+        (35.0, 25.0, 2, 75.0),
+        (40.0, 30.0, 2, 70.0),
+    ] {
         let t = 0.5;
         let run = |phi: f64| {
             let text = stack(dip, phi, layers, Some(cross));
