@@ -195,3 +195,59 @@ fn bad_compare_specs_are_one_line_errors_with_status_2() {
         }
     }
 }
+
+#[test]
+fn compare_render_writes_side_by_side_frames_that_differ_after_the_impact() {
+    let dir = tmp("render");
+    let out = bin()
+        .arg("render")
+        .arg(rockfall())
+        .args([
+            "--compare",
+            "penalty",
+            "--fps",
+            "10",
+            "--msaa",
+            "1",
+            "--gif",
+            "--quiet",
+        ])
+        .args(["--width", "640", "--height", "360", "--duration", "0.5"])
+        .arg("--out")
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if !out.status.success() {
+        if stderr.contains("no GPU adapter") {
+            skip_or_fail("no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)");
+            return;
+        }
+        panic!("render --compare failed ({}):\n{stderr}", out.status);
+    }
+    // Both sides' times, equal on every row.
+    let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    let mut rows = csv.lines();
+    assert_eq!(rows.next(), Some("frame,time,step,file,time_b,step_b"));
+    let rows: Vec<Vec<&str>> = rows.map(|r| r.split(',').collect()).collect();
+    assert_eq!(rows.len(), 6, "frames at 0, 0.1, …, 0.5 s:\n{csv}");
+    for r in &rows {
+        let (ta, tb): (f64, f64) = (r[1].parse().unwrap(), r[4].parse().unwrap());
+        assert!((ta - tb).abs() < 1e-12, "A at {ta}, B at {tb}");
+    }
+    assert!(dir.join("animation.gif").exists());
+    // At 0.4 s, after the strike: both halves show the model, and not the same picture.
+    let img = image::open(dir.join("frame_00004.png")).unwrap().to_rgb8();
+    assert_eq!((img.width(), img.height()), (640, 360));
+    // Below the captions, above the legends.
+    let (a, b) = ([0, 60, 320, 300], [320, 60, 640, 300]);
+    let (va, vb) = (variation(&img, a), variation(&img, b));
+    assert!(va > 0.02, "half A is uniform ({va:.4})");
+    assert!(vb > 0.02, "half B is uniform ({vb:.4})");
+    let d = difference(&img, a, [b[0], b[1]]);
+    assert!(
+        d > 0.003,
+        "the halves show the same picture ({d:.4} of pixels differ)"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
