@@ -50,6 +50,10 @@ pub struct ViewArgs {
     /// --compare.
     #[arg(long, value_name = "KEY=VALUE,...")]
     pub compare_set: Option<String>,
+    /// Compare: open in one pane, run B drawn as a translucent ghost over run A (the toggle
+    /// above the solver panel switches back to two panes).
+    #[arg(long)]
+    pub ghost: bool,
 }
 
 /// Frames rendered before `--screenshot` is taken when `--exit-after-frames` is not given:
@@ -102,6 +106,11 @@ pub fn view(args: &ViewArgs) -> Result<(), CliError> {
     let compare = CompareSpec::parse(args.compare.as_deref(), args.compare_set.as_deref())
         .and_then(|spec| spec.map(|s| s.derive(&scene.params)).transpose())
         .map_err(|e| CliError::Input(e.to_string()))?;
+    if args.ghost && compare.is_none() {
+        return Err(CliError::Input(
+            "--ghost draws run B over run A: add --compare or --compare-set".into(),
+        ));
+    }
     if let Some(n) = args.msaa
         && !matches!(n, 1 | 4)
     {
@@ -138,6 +147,7 @@ pub fn view(args: &ViewArgs) -> Result<(), CliError> {
         exit_after_frames: exit_after,
         msaa: args.msaa,
         out_dir,
+        ghost: args.ghost,
         compare,
     })?;
     Ok(())

@@ -41,6 +41,8 @@ pub struct CompareUi {
     /// The 3-D view's texture of B (the app's second view target) and its rectangle in points.
     pub texture_b: Option<egui::TextureId>,
     pub view_rect_b: egui::Rect,
+    /// One pane: A, with B drawn over it as a translucent ghost (instead of two panes).
+    pub ghost: bool,
 }
 
 /// Common times kept for the difference plot (as the step history, a long run keeps its recent
@@ -79,6 +81,7 @@ impl CompareUi {
             difference: Vec::new(),
             texture_b: None,
             view_rect_b: egui::Rect::NOTHING,
+            ghost: false,
         }
     }
 }
@@ -159,6 +162,11 @@ impl UiState {
         };
         if let Some(s) = self.scene.as_mut() {
             s.caption.scene_name = caption("A", &fa.params, &c.labels.0);
+            if c.ghost {
+                // One pane: the caption says what the blue ghost is.
+                let b = caption("B", &fb.params, &c.labels.1);
+                s.caption.scene_name = format!("{} | ghost {b}", s.caption.scene_name);
+            }
         }
         let key = (fb.seq, style.clone(), wireframe);
         if c.scene_b.is_some() && c.scene_b_key.as_ref() == Some(&key) {

@@ -47,6 +47,8 @@ pub struct ViewerOptions {
     pub out_dir: PathBuf,
     /// `--compare`/`--compare-set`: run B's settings (the scene's are run A's); None: one run.
     pub compare: Option<crate::params::SolverParams>,
+    /// Open a comparison in one pane, B as a ghost over A.
+    pub ghost: bool,
 }
 
 /// Why the viewer could not run or stopped, as one line.

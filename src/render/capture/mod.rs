@@ -208,7 +208,7 @@ impl FrameCapture {
     /// Queues the snapshots of run A and run B at one time as the next side-by-side frame
     /// (a capture with [`CaptureOptions::sides`]).
     pub fn submit_pair(&self, a: Snapshot, b: Snapshot) -> Result<(), RenderError> {
-        self.send(Job::Pair(Box::new((a, b))))
+        self.send(Job::Pair(a, Box::new(b)))
     }
 
     fn send(&self, job: Job) -> Result<(), RenderError> {
@@ -476,14 +476,14 @@ fn render_loop(
     for job in rx {
         let snap = match job {
             Job::One(snap) => snap,
-            Job::Pair(pair) => {
+            Job::Pair(a, b) => {
                 // Drawn in turn on the one target: the previous frame goes out first.
                 if let Some((prev, prev_meta)) = pending.take() {
                     let rgba = off.read(prev)?;
                     sink.dispatch(prev_meta, rgba)?;
                 }
                 let t0 = Instant::now();
-                let (meta, rgba) = pair::render(&mut off, &mut state, opts, &pair, stats.frames)?;
+                let (meta, rgba) = pair::render(&mut off, &mut state, opts, &a, &b, stats.frames)?;
                 stats.frames += 1;
                 stats.busy += t0.elapsed();
                 sink.dispatch(meta, rgba)?;

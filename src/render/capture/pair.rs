@@ -11,7 +11,8 @@ use crate::snapshot::Snapshot;
 /// What the render thread is handed: one snapshot, or A's and B's at one time.
 pub(super) enum Job {
     One(Snapshot),
-    Pair(Box<(Snapshot, Snapshot)>),
+    /// B boxed: a job is moved through a channel, and one snapshot's size is enough.
+    Pair(Snapshot, Box<Snapshot>),
 }
 
 /// Draws both halves and puts them side by side: the frame's metadata and RGBA.
@@ -19,7 +20,8 @@ pub(super) fn render(
     off: &mut Offscreen,
     state: &mut FrameState,
     opts: &CaptureOptions,
-    (a, b): &(Snapshot, Snapshot),
+    a: &Snapshot,
+    b: &Snapshot,
     index: usize,
 ) -> Result<(FrameMeta, Vec<u8>), RenderError> {
     let captions = opts.sides.clone().unwrap_or_default();

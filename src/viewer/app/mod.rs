@@ -399,6 +399,9 @@ impl Viewer {
         let (Some(view), Some(c)) = (self.view_b.as_mut(), self.ui.compare.as_deref()) else {
             return;
         };
+        if c.ghost {
+            return; // B is drawn by egui over A's pane
+        }
         let (vw, vh) = pixels(c.view_rect_b, pixels_per_point);
         view.resize(&self.gpu, &mut self.egui.painter, vw, vh);
         let Some(scene) = &c.scene_b else {

@@ -79,7 +79,9 @@ impl SimLink {
     /// B's compare state for the panels, with a comparison.
     pub fn compare_ui(&self, opts: &ViewerOptions) -> Option<Box<CompareUi>> {
         let b = opts.compare.as_ref()?;
-        Some(Box::new(CompareUi::new(&opts.scene.params, b)))
+        let mut c = CompareUi::new(&opts.scene.params, b);
+        c.ghost = opts.ghost;
+        Some(Box::new(c))
     }
 
     /// Gives the panels the newest frame(s) and the step records since the last call.

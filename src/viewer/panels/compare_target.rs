@@ -1,5 +1,6 @@
 //! In a comparison, which run the solver panel edits: A, B or both (an edit to both changes
-//! only the keys edited, so B keeps the settings that set it apart).
+//! only the keys edited, so B keeps the settings that set it apart); and the one-pane mode with
+//! B as a ghost over A.
 
 use egui::RichText;
 
@@ -24,8 +25,14 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState) {
         ui.selectable_value(&mut target, EditTarget::Both, "A and B")
             .on_hover_text("The keys edited change in both runs; the others stay as they are");
     });
+    let mut ghost = c.ghost;
+    ui.checkbox(&mut ghost, "One pane, B as a ghost over A")
+        .on_hover_text("Draw run B's blocks translucent in blue over run A's picture");
     if target != c.target {
         state.set_edit_target(target);
+    }
+    if let Some(c) = state.compare.as_deref_mut() {
+        c.ghost = ghost;
     }
     ui.add_space(4.0);
 }

@@ -10,6 +10,7 @@
 mod compare_plots;
 mod compare_target;
 mod display;
+mod ghost;
 mod plots;
 mod run;
 mod selection;

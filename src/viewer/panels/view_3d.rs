@@ -18,7 +18,8 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState, texture: egui::TextureId) {
     let full = ui.max_rect();
     // A comparison splits the view into two panes, A left and B right, seen by one camera:
     // one response over both, so orbit and zoom in either pane move both.
-    let (rect, rect_b) = if state.compare.is_some() {
+    let split = state.compare.as_deref().is_some_and(|c| !c.ghost);
+    let (rect, rect_b) = if split {
         let (l, r) = full.split_left_right_at_fraction(0.5);
         (l, Some(r.shrink2(Vec2::new(1.0, 0.0))))
     } else {
@@ -57,6 +58,11 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState, texture: egui::TextureId) {
         block_labels(&painter, rect, snap, state.selected, &to_screen);
     }
 
+    if let Some(b) = state.compare.as_deref().filter(|c| c.ghost)
+        && let Some(fb) = &b.frame_b
+    {
+        super::ghost::paint(&painter, state, &fb.snapshot, rect);
+    }
     if let Some(scene) = &state.scene
         && scene.overlay
     {
