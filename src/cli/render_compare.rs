@@ -10,13 +10,12 @@ use std::time::Instant;
 use super::Progress;
 use super::exit::{self, Failure};
 use super::render::{RenderArgs, Simulated, capture_failure, capture_options, write_summary};
-use crate::compare::{CompareSpec, labels};
+use crate::compare::{CompareSpec, caption, labels};
 use crate::output::slug;
 use crate::render::{FrameCapture, RenderError};
 use crate::scene::Scene;
 use crate::solver::Solver;
 use crate::text::short;
-use crate::viewer::compare_ui::caption;
 
 /// `render --compare`: as `render`, with two runs in each frame.
 pub(super) fn execute(args: &RenderArgs, scene: Scene, spec: &CompareSpec) -> Result<(), Failure> {

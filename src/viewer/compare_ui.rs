@@ -9,9 +9,9 @@ use std::sync::Arc;
 
 use super::sim::{Frame, StepRecord};
 use super::state::{History, UiState};
-use crate::compare::{compare_snapshots, labels};
+use crate::compare::{caption, compare_snapshots, labels};
+use crate::params::SolverParams;
 use crate::params::table;
-use crate::params::{Method, SolverParams};
 use crate::render::{RenderScene, SceneStyle};
 
 /// Which run the solver panel's edits go to.
@@ -48,24 +48,6 @@ pub struct CompareUi {
 /// Common times kept for the difference plot (as the step history, a long run keeps its recent
 /// past).
 const DIFFERENCE_CAP: usize = 200_000;
-
-/// A method as the paper names it: "ALM (DDA-3a)", "penalty (DDA-3p)".
-pub fn method_name(m: Method) -> &'static str {
-    match m {
-        Method::Alm => "ALM (DDA-3a)",
-        Method::Penalty => "penalty (DDA-3p)",
-    }
-}
-
-/// The caption of one side's pane: "A: ALM (DDA-3a)   method=alm".
-pub fn caption(side: &str, params: &SolverParams, labels: &[String]) -> String {
-    let mut s = format!("{side}: {}", method_name(params.method));
-    if !labels.is_empty() {
-        s.push_str("   ");
-        s.push_str(&labels.join(", "));
-    }
-    s
-}
 
 impl CompareUi {
     pub fn new(a: &SolverParams, b: &SolverParams) -> CompareUi {

@@ -4,7 +4,8 @@
 
 use egui::RichText;
 
-use crate::viewer::compare_ui::{EditTarget, method_name};
+use crate::compare::method_name;
+use crate::viewer::compare_ui::EditTarget;
 use crate::viewer::state::UiState;
 
 pub fn show(ui: &mut egui::Ui, state: &mut UiState) {
