@@ -185,3 +185,100 @@ impl UiState {
         out
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::params::Method;
+    use crate::viewer::sim::{RunState, Speed};
+
+    /// The rockfall's UiState with a comparison, and a frame of each side at t = 0 (B with the
+    /// penalty method).
+    fn rockfall() -> (UiState, Frame, Frame) {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes")
+            .join("rock_column_rockfall.toml");
+        let scene = crate::scene::load(&path).unwrap();
+        let solver = crate::solver::Solver::new(scene.model.clone(), scene.params.clone());
+        let snap = Arc::new(solver.snapshot());
+        let mut state = UiState::new(&scene, &snap, "test".into());
+        let a = Frame {
+            seq: 1,
+            applied: 0,
+            generation: 0,
+            snapshot: snap,
+            params: scene.params.clone(),
+            state: RunState::Paused,
+            speed: Speed::Max,
+            error: None,
+            notice: None,
+            steps_per_second: 0.0,
+            seconds_per_step: 0.0,
+            running_seconds: 0.0,
+            totals: solver.totals.clone(),
+            max_step_penetration: solver.max_step_penetration(),
+        };
+        let mut b = a.clone();
+        b.params.method = Method::Penalty;
+        state.compare = Some(Box::new(CompareUi::new(&a.params, &b.params)));
+        (state, a, b)
+    }
+
+    #[test]
+    fn an_edit_to_both_changes_the_keys_edited_and_keeps_what_sets_b_apart() {
+        let (_, a, b) = rockfall();
+        let mut new = a.params.clone();
+        new.contact.alpha = 7.5;
+        new.joint.friction_angle = 20.0;
+        let to_b = UiState::apply_edit_to(&a.params, &new, &b.params);
+        assert_eq!(to_b.method, Method::Penalty, "B stays penalty");
+        assert_eq!(to_b.contact.alpha, 7.5);
+        assert_eq!(to_b.joint.friction_angle, 20.0);
+        let mut back = to_b.clone();
+        back.method = Method::Alm;
+        assert_eq!(back, new, "nothing else differs");
+    }
+
+    #[test]
+    fn the_widgets_follow_the_side_edited_and_the_difference_plot_the_common_times() {
+        let (mut st, a, b) = rockfall();
+        st.update(Some(Arc::new(a.clone())), &mut Vec::new());
+        st.update_b(Arc::new(b.clone()), &mut Vec::new());
+        assert_eq!(st.params.edit.method, Method::Alm, "A by default");
+        let c = st.compare.as_ref().unwrap();
+        assert_eq!(c.labels.0, vec!["method=alm".to_owned()]);
+        assert_eq!(c.labels.1, vec!["method=penalty".to_owned()]);
+        assert_eq!(
+            c.difference,
+            vec![[0.0, 0.0]],
+            "one common time, no difference yet"
+        );
+        st.set_edit_target(EditTarget::B);
+        assert_eq!(
+            st.params.edit.method,
+            Method::Penalty,
+            "B's settings at once"
+        );
+        // A's next frame leaves the widgets on B.
+        st.update(Some(Arc::new(Frame { seq: 2, ..a })), &mut Vec::new());
+        assert_eq!(st.params.edit.method, Method::Penalty);
+        assert!(st.param_change().is_none(), "nothing to send");
+        st.set_edit_target(EditTarget::Both);
+        assert_eq!(
+            st.params.edit.method,
+            Method::Alm,
+            "both: A's settings shown"
+        );
+        // A pair at two different times adds no point.
+        let later = Frame {
+            seq: 2,
+            snapshot: Arc::new(crate::snapshot::Snapshot {
+                time: 0.01,
+                ..(*b.snapshot).clone()
+            }),
+            ..b
+        };
+        st.update_b(Arc::new(later), &mut Vec::new());
+        assert_eq!(st.compare.as_ref().unwrap().difference.len(), 1);
+    }
+}
