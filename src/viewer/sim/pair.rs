@@ -26,9 +26,14 @@ pub enum Side {
     B,
 }
 
-/// Simulated time handed out at a time at `--speed max`: small enough that the panes move
-/// smoothly, large enough that the window's frame rate does not hold the solvers back much.
-const MAX_SPEED_CHUNK: f64 = 0.02;
+/// Simulated time handed out at a time at `--speed max`: it starts at the first value and
+/// adapts between the bounds, growing when both runs had already reached the limit by the
+/// next frame (the window held them back) and shrinking when they had not (they hold the
+/// window back, and the panes would move in jumps). The lower bound is a time step of the
+/// shipped scenes, so that the limits shorten few steps.
+const MAX_SPEED_CHUNK: (f64, f64, f64) = (0.02, 0.01, 0.25);
+/// The factor by which the chunk at `--speed max` grows or shrinks.
+const CHUNK_FACTOR: f64 = 1.25;
 /// At a real-time factor f, f × this much simulated time is handed out at a time (about two
 /// frames at 60 Hz); each thread still keeps to the factor by itself.
 const REAL_TIME_CHUNK: f64 = 1.0 / 30.0;
@@ -52,6 +57,8 @@ pub struct SimPair {
     target: f64,
     mode: Mode,
     speed: Speed,
+    /// The simulated time handed out at a time at `--speed max` (see [`MAX_SPEED_CHUNK`]).
+    chunk: f64,
     /// The newest pair of frames with the same simulated time.
     shown: (Arc<Frame>, Arc<Frame>),
 }
@@ -80,6 +87,7 @@ impl SimPair {
             target: 0.0,
             mode: Mode::Paused,
             speed,
+            chunk: MAX_SPEED_CHUNK.0,
             shown,
         };
         if play {
@@ -147,7 +155,7 @@ impl SimPair {
     /// Hands out the next limit.
     fn hand_out(&mut self) {
         let chunk = match self.speed {
-            Speed::Max => MAX_SPEED_CHUNK,
+            Speed::Max => self.chunk,
             Speed::RealTime(f) => f * REAL_TIME_CHUNK,
         };
         self.target += chunk;
@@ -184,7 +192,13 @@ impl SimPair {
                 // One run ended (its end time, or a solver error): the other waits with it.
                 self.mode = Mode::PauseAtLimit;
             }
-            Mode::Playing if reached => self.hand_out(),
+            Mode::Playing if reached => {
+                self.chunk = (self.chunk * CHUNK_FACTOR).min(MAX_SPEED_CHUNK.2);
+                self.hand_out();
+            }
+            Mode::Playing => {
+                self.chunk = (self.chunk / CHUNK_FACTOR).max(MAX_SPEED_CHUNK.1);
+            }
             Mode::PauseAtLimit if reached || stopped => {
                 self.mode = Mode::Paused;
                 self.both(Command::Pause);
