@@ -35,8 +35,12 @@ const MAX_SPEED_CHUNK: (f64, f64, f64) = (0.02, 0.01, 0.25);
 /// The factor by which the chunk at `--speed max` grows or shrinks.
 const CHUNK_FACTOR: f64 = 1.25;
 /// At a real-time factor f, f × this much simulated time is handed out at a time (about two
-/// frames at 60 Hz); each thread still keeps to the factor by itself.
+/// frames at 60 Hz), but not less than [`REAL_TIME_FLOOR`]; each thread still keeps to the
+/// factor by itself.
 const REAL_TIME_CHUNK: f64 = 1.0 / 30.0;
+/// The least simulated time handed out at a time when paced, s: deep slow motion must not cut
+/// every step down to a sliver (the panes then move five times a wall second at 0.01×).
+const REAL_TIME_FLOOR: f64 = 0.002;
 
 /// What the pair is doing between limits.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -156,7 +160,7 @@ impl SimPair {
     fn hand_out(&mut self) {
         let chunk = match self.speed {
             Speed::Max => self.chunk,
-            Speed::RealTime(f) => f * REAL_TIME_CHUNK,
+            Speed::RealTime(f) => (f * REAL_TIME_CHUNK).max(REAL_TIME_FLOOR),
         };
         self.target += chunk;
         self.both(Command::SetLimit(Some(self.target)));
