@@ -14,6 +14,7 @@ mod cut;
 pub mod exit;
 mod generate;
 mod render;
+mod render_compare;
 mod resume;
 mod run;
 mod view;

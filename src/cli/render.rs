@@ -8,6 +8,7 @@ use clap::Args;
 
 use super::exit::{self, Failure, Signal};
 use super::{CliError, Progress, SolverOverrides, load_scene};
+use crate::compare::CompareSpec;
 use crate::output::{slug, write_atomically};
 use crate::render::{
     ArrowMode, CameraOverride, CaptureOptions, CaptureReport, Coloring, FrameCapture, Framing,
@@ -69,22 +70,31 @@ pub struct RenderArgs {
     pub msaa: u32,
     #[arg(long, short)]
     pub quiet: bool,
+    /// Compare: also run the scene with the contact method METHOD (alm or penalty) as run B,
+    /// the scene's settings being run A; each frame shows A left and B right at one time.
+    #[arg(long, value_name = "METHOD")]
+    pub compare: Option<String>,
+    /// Compare: run B's settings as changes to A's, any scene-file key of [solver],
+    /// [solver.contact] and [joint] (e.g. initial_penalty=2e9,eps1=0.001); with or without
+    /// --compare.
+    #[arg(long, value_name = "KEY=VALUE,...")]
+    pub compare_set: Option<String>,
 }
 
 /// What the simulation side of a render did.
-struct Simulated {
-    /// Wall time spent in the solver, s.
-    seconds: f64,
+pub(super) struct Simulated {
+    /// Wall time spent in the solver (both solvers of a comparison), s.
+    pub seconds: f64,
     /// The solver error that ended the run early, if any.
-    failure: Option<SolverError>,
+    pub failure: Option<SolverError>,
     /// The stop signal that ended the run early, if any.
-    interrupted: Option<Signal>,
+    pub interrupted: Option<Signal>,
 }
 
 /// A capture failure with its exit status: a file that cannot be written is an I/O error, a
 /// missing GPU or bad options bad input, and the rest (the device, a worker) a failure of
 /// neither.
-fn capture_failure(out: &Path, e: RenderError) -> Failure {
+pub(super) fn capture_failure(out: &Path, e: RenderError) -> Failure {
     match e {
         RenderError::NoAdapter | RenderError::InvalidOptions(_) => Failure::Input(e.to_string()),
         // The encoders' errors are the PNG writer's, that is the file's.
@@ -101,6 +111,11 @@ fn capture_failure(out: &Path, e: RenderError) -> Failure {
 pub(super) fn execute(args: &RenderArgs) -> Result<(), Failure> {
     let scene = load_scene(&args.scene, &args.overrides)?;
     check_image_options(args)?;
+    if let Some(spec) = CompareSpec::parse(args.compare.as_deref(), args.compare_set.as_deref())
+        .map_err(|e| Failure::Input(e.to_string()))?
+    {
+        return super::render_compare::execute(args, scene, &spec);
+    }
     let out = args
         .out
         .clone()
@@ -156,7 +171,7 @@ pub fn render(args: &RenderArgs) -> Result<(), CliError> {
 }
 
 /// The checks of `--fps`, `--width`/`--height` and `--msaa` that need no GPU.
-fn check_image_options(args: &RenderArgs) -> Result<(), CliError> {
+pub(super) fn check_image_options(args: &RenderArgs) -> Result<(), CliError> {
     if !(args.fps.is_finite() && args.fps > 0.0) {
         return Err(CliError::Input(format!(
             "--fps must be positive, got {}",
@@ -179,7 +194,7 @@ fn check_image_options(args: &RenderArgs) -> Result<(), CliError> {
 }
 
 /// The capture pipeline's options from the command line: size, camera, style and framing.
-fn capture_options(args: &RenderArgs, out: &Path) -> Result<CaptureOptions, CliError> {
+pub(super) fn capture_options(args: &RenderArgs, out: &Path) -> Result<CaptureOptions, CliError> {
     let mut opts = CaptureOptions::new(out);
     opts.width = args.width;
     opts.height = args.height;
@@ -274,7 +289,7 @@ fn simulate_frames(
 
 /// Writes render_summary.json (atomically): frame count, size, adapter, where the time went,
 /// and how the run ended.
-fn write_summary(
+pub(super) fn write_summary(
     out: &Path,
     name: &str,
     args: &RenderArgs,

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use clap::Args;
 
 use super::{CliError, SolverOverrides, load_scene};
+use crate::compare::CompareSpec;
 use crate::output::slug;
 use crate::viewer::sim::Speed;
 use crate::viewer::{ViewerError, ViewerOptions, run_viewer};
@@ -40,6 +41,19 @@ pub struct ViewArgs {
     /// Directory for the screenshot button and recordings (default: out/<scene name>).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Compare: also run the scene with the contact method METHOD (alm or penalty) as run B,
+    /// the scene's own settings being run A, side by side in lock-step of simulated time.
+    #[arg(long, value_name = "METHOD")]
+    pub compare: Option<String>,
+    /// Compare: run B's settings as changes to A's, any scene-file key of [solver],
+    /// [solver.contact] and [joint] (e.g. initial_penalty=2e9,eps1=0.001); with or without
+    /// --compare.
+    #[arg(long, value_name = "KEY=VALUE,...")]
+    pub compare_set: Option<String>,
+    /// Compare: open in one pane, run B drawn as a translucent ghost over run A (the toggle
+    /// above the solver panel switches back to two panes).
+    #[arg(long)]
+    pub ghost: bool,
 }
 
 /// Frames rendered before `--screenshot` is taken when `--exit-after-frames` is not given:
@@ -88,6 +102,15 @@ impl From<ViewerError> for CliError {
 /// `dda3d view`.
 pub fn view(args: &ViewArgs) -> Result<(), CliError> {
     let scene = load_scene(&args.scene, &args.overrides)?;
+    // Checked as `run --compare` checks it: one line naming the flag and the key, exit 2.
+    let compare = CompareSpec::parse(args.compare.as_deref(), args.compare_set.as_deref())
+        .and_then(|spec| spec.map(|s| s.derive(&scene.params)).transpose())
+        .map_err(|e| CliError::Input(e.to_string()))?;
+    if args.ghost && compare.is_none() {
+        return Err(CliError::Input(
+            "--ghost draws run B over run A: add --compare or --compare-set".into(),
+        ));
+    }
     if let Some(n) = args.msaa
         && !matches!(n, 1 | 4)
     {
@@ -124,6 +147,8 @@ pub fn view(args: &ViewArgs) -> Result<(), CliError> {
         exit_after_frames: exit_after,
         msaa: args.msaa,
         out_dir,
+        ghost: args.ghost,
+        compare,
     })?;
     Ok(())
 }

@@ -1,8 +1,8 @@
 //! The parameters in which two runs differ, as short `name=value` labels: what a caption over
 //! two pictures, or the head of `compare.json`, says about A and B.
 
-use crate::params::SolverParams;
 use crate::params::table::{self, Param};
+use crate::params::{Method, SolverParams};
 
 /// One key whose value differs between A and B, with each side's value as text
 /// ([`Param::text`]: short where that is exact, so `2e9`, not `2000000000`).
@@ -45,6 +45,25 @@ pub fn labels(a: &SolverParams, b: &SolverParams) -> (Vec<String>, Vec<String>) 
         .iter()
         .map(|d| (d.label_a(), d.label_b()))
         .unzip()
+}
+
+/// A method as the paper names it: "ALM (DDA-3a)", "penalty (DDA-3p)".
+pub fn method_name(m: Method) -> &'static str {
+    match m {
+        Method::Alm => "ALM (DDA-3a)",
+        Method::Penalty => "penalty (DDA-3p)",
+    }
+}
+
+/// The caption of one side's picture (the viewer's pane, a half of a `render --compare`
+/// frame): "A: ALM (DDA-3a)   method=alm".
+pub fn caption(side: &str, params: &SolverParams, labels: &[String]) -> String {
+    let mut s = format!("{side}: {}", method_name(params.method));
+    if !labels.is_empty() {
+        s.push_str("   ");
+        s.push_str(&labels.join(", "));
+    }
+    s
 }
 
 #[cfg(test)]

@@ -5,7 +5,8 @@
 //!
 //! - [`spec`]: what B changes of A (`--compare alm|penalty`, `--compare-set key=value,...`),
 //!   checked as the scene file is;
-//! - [`labels`]: the settings that tell A and B apart, as `name=value` labels;
+//! - [`labels`]: the settings that tell A and B apart, as `name=value` labels, and the
+//!   captions of A's and B's pictures;
 //! - [`sample`]: what a comparison keeps of a run at one time, and that state between two
 //!   steps (each run keeps its own steps);
 //! - [`difference`]: A and B at one time (largest block displacement difference, contact
@@ -27,7 +28,7 @@ pub mod spec;
 pub mod tables;
 
 pub use difference::{Comparison, compare, compare_snapshots};
-pub use labels::{Difference, differences, labels};
+pub use labels::{Difference, caption, differences, labels, method_name};
 pub use report::{Recorder, Report, RunReport};
 pub use sample::Sample;
 pub use slope::{Motion, SlopeCase};

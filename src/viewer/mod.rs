@@ -3,6 +3,7 @@
 //! - [`sim`]: the simulation thread and its command/frame protocol;
 //! - [`view`]: camera controls and picking (pure logic);
 //! - [`state`]: what the viewer remembers between frames;
+//! - [`compare_ui`]: what it remembers of run B in a comparison (`view --compare`);
 //! - [`panels`]: the egui panels (toolbar, parameters, display, selection, plots, 3-D view), one
 //!   file each;
 //! - `app/`: the winit application and the frame loop, with its parts: the window and its
@@ -13,6 +14,7 @@
 //! [`ViewerError`]; `crate::cli` reads the flags and maps the error to an exit status.
 
 mod app;
+pub mod compare_ui;
 pub mod painter;
 pub mod panels;
 pub mod sim;
@@ -43,6 +45,10 @@ pub struct ViewerOptions {
     pub msaa: Option<u32>,
     /// Directory for the screenshot button and recordings.
     pub out_dir: PathBuf,
+    /// `--compare`/`--compare-set`: run B's settings (the scene's are run A's); None: one run.
+    pub compare: Option<crate::params::SolverParams>,
+    /// Open a comparison in one pane, B as a ghost over A.
+    pub ghost: bool,
 }
 
 /// Why the viewer could not run or stopped, as one line.

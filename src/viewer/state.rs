@@ -247,6 +247,8 @@ pub struct UiState {
     pub out_dir: std::path::PathBuf,
     /// The command id of the last sim notice shown ([`Frame::notice`]).
     last_notice: u64,
+    /// Run B of `view --compare` (None: one run).
+    pub compare: Option<Box<super::compare_ui::CompareUi>>,
 }
 
 impl UiState {
@@ -278,6 +280,7 @@ impl UiState {
             adapter,
             out_dir: std::path::PathBuf::from("out"),
             last_notice: 0,
+            compare: None,
         }
     }
 
@@ -291,7 +294,7 @@ impl UiState {
             }
             // Only a frame that has seen the last edit may overwrite the widgets; older ones
             // would make a slider jump back while it is being dragged.
-            if f.applied >= self.params.sent_id {
+            if f.applied >= self.params.sent_id && self.edit_follows_a() {
                 self.params.edit = f.params.clone();
                 self.params.last_sent = f.params.clone();
                 self.speed = f.speed;
@@ -339,12 +342,23 @@ impl UiState {
 
     /// The edited parameters when they differ from those last sent (then counted as sent).
     pub fn param_change(&mut self) -> Option<SolverParams> {
+        self.param_edit().map(|(_, new)| new)
+    }
+
+    /// As [`UiState::param_change`], with the settings last sent before it: (old, new).
+    pub fn param_edit(&mut self) -> Option<(SolverParams, SolverParams)> {
         let p = &mut self.params;
         if p.edit == p.last_sent {
             return None;
         }
-        p.last_sent = p.edit.clone();
-        Some(p.edit.clone())
+        let old = std::mem::replace(&mut p.last_sent, p.edit.clone());
+        Some((old, p.edit.clone()))
+    }
+
+    /// The widgets show (and count as sent) these settings: a run's newest.
+    pub(super) fn follow_edit(&mut self, params: &SolverParams) {
+        self.params.edit = params.clone();
+        self.params.last_sent = params.clone();
     }
 
     /// Call after the app sent a SetParams or SetSpeed, so that frames published before the

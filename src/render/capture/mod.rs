@@ -19,6 +19,7 @@
 mod encode;
 mod frames;
 mod options;
+mod pair;
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -35,6 +36,7 @@ use super::offscreen::{Offscreen, Pending};
 use crate::snapshot::Snapshot;
 use encode::{EncodeJob, GifFrame, encode_loop, gif_loop};
 use frames::FrameState;
+use pair::Job;
 
 pub use encode::{unpremultiply, write_png};
 pub use frames::{render_rgba, render_to_png};
@@ -94,7 +96,7 @@ struct RenderStats {
 
 /// A running capture. Submit snapshots in time order, then call [`FrameCapture::finish`].
 pub struct FrameCapture {
-    tx: Option<SyncSender<Snapshot>>,
+    tx: Option<SyncSender<Job>>,
     render: Option<Worker<RenderStats>>,
     encoders: Vec<Worker<Duration>>,
     gif: Option<Worker<Duration>>,
@@ -142,10 +144,14 @@ impl FrameCapture {
     ) -> Result<FrameCapture, RenderError> {
         std::fs::create_dir_all(&opts.out_dir).map_err(|e| RenderError::io(&opts.out_dir, e))?;
         let adapter = gpu.adapter_summary();
-        let offscreen =
-            Offscreen::with_max_samples(gpu, opts.width, opts.height, opts.max_msaa_samples)?;
+        // A side-by-side frame is two half-width pictures of the same size and camera.
+        let (w, halves) = match &opts.sides {
+            Some(_) => (opts.width / 2, 2),
+            None => (opts.width, 1),
+        };
+        let offscreen = Offscreen::with_max_samples(gpu, w, opts.height, opts.max_msaa_samples)?;
         let samples = offscreen.samples();
-        let csv = FramesCsv::create(opts.out_dir.join("frames.csv"))?;
+        let csv = FramesCsv::create(opts.out_dir.join("frames.csv"), opts.sides.is_some())?;
         let failure: Failure = Arc::new(Mutex::new(None));
         let (encode_tx, encoders) = spawn_encoders(opts.encoder_count(), &failure)?;
         let gif_path = opts.gif.then(|| opts.out_dir.join("animation.gif"));
@@ -157,6 +163,7 @@ impl FrameCapture {
             None => (None, None),
         };
         let (width, height) = offscreen.size();
+        let width = width * halves;
         let sink = FrameSink {
             out_dir: opts.out_dir.clone(),
             csv,
@@ -167,7 +174,7 @@ impl FrameCapture {
             transparent: opts.style.transparent,
         };
         // Bounded: the solver may run at most two snapshots ahead of the renderer.
-        let (tx, rx) = mpsc::sync_channel::<Snapshot>(2);
+        let (tx, rx) = mpsc::sync_channel::<Job>(2);
         let render = {
             let opts = opts.clone();
             spawn_worker("dda3d-render".into(), "render", &failure, move || {
@@ -195,11 +202,21 @@ impl FrameCapture {
     /// Queues a snapshot as the next frame. Blocks while the pipeline is full; returns the
     /// workers' error if they have stopped.
     pub fn submit(&self, snapshot: Snapshot) -> Result<(), RenderError> {
+        self.send(Job::One(snapshot))
+    }
+
+    /// Queues the snapshots of run A and run B at one time as the next side-by-side frame
+    /// (a capture with [`CaptureOptions::sides`]).
+    pub fn submit_pair(&self, a: Snapshot, b: Snapshot) -> Result<(), RenderError> {
+        self.send(Job::Pair(a, Box::new(b)))
+    }
+
+    fn send(&self, job: Job) -> Result<(), RenderError> {
         let Some(tx) = &self.tx else {
             return Err(RenderError::Stopped("capture already finished".into()));
         };
         let t = Instant::now();
-        let sent = tx.send(snapshot);
+        let sent = tx.send(job);
         self.blocked_nanos
             .fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
         match sent {
@@ -220,7 +237,7 @@ impl FrameCapture {
         let Some(tx) = &self.tx else {
             return Err(RenderError::Stopped("capture already finished".into()));
         };
-        match tx.try_send(snapshot) {
+        match tx.try_send(Job::One(snapshot)) {
             Ok(()) => {
                 self.submitted.fetch_add(1, Ordering::Relaxed);
                 Ok(true)
@@ -371,6 +388,8 @@ struct FrameMeta {
     index: usize,
     time: f64,
     step: u64,
+    /// Run B's time and step in a side-by-side frame.
+    b: Option<(f64, u64)>,
 }
 
 /// `frames.csv`: one row per frame, flushed at once so the file lists every frame handed to
@@ -381,17 +400,23 @@ struct FramesCsv {
 }
 
 impl FramesCsv {
-    fn create(path: PathBuf) -> Result<FramesCsv, RenderError> {
+    fn create(path: PathBuf, sides: bool) -> Result<FramesCsv, RenderError> {
         let file = File::create(&path).map_err(|e| RenderError::io(&path, e))?;
         let mut writer = BufWriter::new(file);
-        writeln!(writer, "frame,time,step,file").map_err(|e| RenderError::io(&path, e))?;
+        let header = if sides {
+            "frame,time,step,file,time_b,step_b"
+        } else {
+            "frame,time,step,file"
+        };
+        writeln!(writer, "{header}").map_err(|e| RenderError::io(&path, e))?;
         Ok(FramesCsv { writer, path })
     }
 
     fn row(&mut self, meta: &FrameMeta, file: &str) -> Result<(), RenderError> {
+        let b = meta.b.map_or(String::new(), |(t, s)| format!(",{t},{s}"));
         writeln!(
             self.writer,
-            "{},{},{},{}",
+            "{},{},{},{}{b}",
             meta.index, meta.time, meta.step, file
         )
         .and_then(|_| self.writer.flush())
@@ -440,7 +465,7 @@ impl FrameSink {
 /// The render thread: builds each snapshot's scene, draws it, and reads the previous frame
 /// back while the GPU works on this one.
 fn render_loop(
-    rx: Receiver<Snapshot>,
+    rx: Receiver<Job>,
     mut off: Offscreen,
     opts: &CaptureOptions,
     mut sink: FrameSink,
@@ -448,7 +473,23 @@ fn render_loop(
     let mut state = FrameState::new(opts);
     let mut stats = RenderStats::default();
     let mut pending: Option<(Pending, FrameMeta)> = None;
-    for snap in rx {
+    for job in rx {
+        let snap = match job {
+            Job::One(snap) => snap,
+            Job::Pair(a, b) => {
+                // Drawn in turn on the one target: the previous frame goes out first.
+                if let Some((prev, prev_meta)) = pending.take() {
+                    let rgba = off.read(prev)?;
+                    sink.dispatch(prev_meta, rgba)?;
+                }
+                let t0 = Instant::now();
+                let (meta, rgba) = pair::render(&mut off, &mut state, opts, &a, &b, stats.frames)?;
+                stats.frames += 1;
+                stats.busy += t0.elapsed();
+                sink.dispatch(meta, rgba)?;
+                continue;
+            }
+        };
         let t0 = Instant::now();
         let (scene, camera) = state.scene(&snap, opts, off.aspect())?;
         let p = off.submit(&scene, &camera)?;
@@ -456,6 +497,7 @@ fn render_loop(
             index: stats.frames,
             time: snap.time,
             step: snap.step,
+            b: None,
         };
         stats.frames += 1;
         // While this frame draws, read back the previous one.

@@ -41,6 +41,10 @@ pub struct CaptureOptions {
     /// Upper bound on MSAA samples (4 by default; 1 turns antialiasing off, about 3× faster
     /// on the software driver, for quick previews).
     pub max_msaa_samples: u32,
+    /// A side-by-side comparison (`render --compare`): the captions of the left (A) and right
+    /// (B) halves. Each frame is then a pair of snapshots ([`super::FrameCapture::submit_pair`]),
+    /// both halves seen by the same camera, and frames.csv lists both sides' times.
+    pub sides: Option<[String; 2]>,
 }
 
 impl CaptureOptions {
@@ -58,6 +62,7 @@ impl CaptureOptions {
             gif_max_width: 640,
             encoder_threads: 0,
             max_msaa_samples: 4,
+            sides: None,
         }
     }
 
@@ -66,6 +71,12 @@ impl CaptureOptions {
             return Err(RenderError::InvalidOptions(format!(
                 "image size must be positive, got {}x{}",
                 self.width, self.height
+            )));
+        }
+        if self.sides.is_some() && self.width < 2 {
+            return Err(RenderError::InvalidOptions(format!(
+                "a side-by-side image needs a width of at least 2, got {}",
+                self.width
             )));
         }
         if self.gif && !(self.fps.is_finite() && self.fps > 0.0) {

@@ -14,6 +14,7 @@
 //! report).
 
 mod capture;
+mod sim_link;
 mod surface;
 mod timing;
 mod view_target;
@@ -27,11 +28,12 @@ use winit::window::WindowId;
 
 use super::painter::{EguiPainter, Screen};
 use super::panels;
-use super::sim::{Command, RunState, SimHandle, StepRecord};
+use super::sim::RunState;
 use super::state::{Action, UiState};
 use super::{ViewerError, ViewerOptions};
 use crate::render::Gpu;
 use capture::{Capture, WindowCapture};
+use sim_link::SimLink;
 use surface::{Acquired, EguiLayer, WindowSurface, is_software};
 use timing::{FrameClock, Timing};
 use view_target::ViewTarget;
@@ -154,42 +156,6 @@ enum Flow {
     Exit,
 }
 
-/// The window's end of the simulation: the thread's handle, and a buffer for the step records
-/// it hands over to the panel.
-struct SimLink {
-    handle: SimHandle,
-    records: Vec<StepRecord>,
-}
-
-impl SimLink {
-    /// Starts the simulation of the options' scene; each new frame wakes the event loop.
-    fn start(opts: &ViewerOptions, proxy: EventLoopProxy<Wake>) -> Result<SimLink, ViewerError> {
-        let scene = &opts.scene;
-        let waker = Box::new(move || {
-            let _ = proxy.send_event(Wake);
-        });
-        let handle = SimHandle::spawn(
-            scene.model.clone(),
-            scene.params.clone(),
-            opts.speed,
-            opts.play,
-            waker,
-        )
-        .map_err(|e| ViewerError::Failed(format!("cannot start the simulation thread: {e}")))?;
-        Ok(SimLink {
-            handle,
-            records: Vec::new(),
-        })
-    }
-
-    /// Gives the panel the newest frame and the step records since the last call.
-    fn update(&mut self, ui: &mut UiState) {
-        let frame = self.handle.latest();
-        self.handle.drain_records(&mut self.records);
-        ui.update(frame, &mut self.records);
-    }
-}
-
 /// What egui produced for one frame, ready to paint.
 struct UiFrame {
     primitives: Vec<egui::ClippedPrimitive>,
@@ -213,6 +179,8 @@ struct Viewer {
     gpu: Gpu,
     egui: EguiLayer,
     view: ViewTarget,
+    /// Run B's 3-D view in a comparison.
+    view_b: Option<ViewTarget>,
     sim: SimLink,
     ui: UiState,
     capture: Capture,
@@ -239,16 +207,22 @@ impl Viewer {
         );
         let sim = SimLink::start(&opts, proxy.clone())?;
         let first = sim
-            .handle
-            .latest()
+            .first_frame()
             .ok_or_else(|| ViewerError::Failed("the simulation published no state".into()))?;
         let mut ui = UiState::new(&opts.scene, &first.snapshot, adapter);
         ui.out_dir = opts.out_dir.clone();
+        ui.compare = sim.compare_ui(&opts);
+        let view_b = ui.compare.as_mut().map(|c| {
+            let v = ViewTarget::new(&gpu, &mut egui.painter, samples);
+            c.texture_b = Some(v.id);
+            v
+        });
         Ok(Viewer {
             surface,
             gpu,
             egui,
             view,
+            view_b,
             sim,
             ui,
             capture: Capture::new(opts.out_dir, opts.screenshot, proxy),
@@ -365,13 +339,7 @@ impl Viewer {
         let size = self.window_size();
         for a in actions {
             match a {
-                Action::Sim(cmd) => {
-                    let shown = matches!(cmd, Command::SetSpeed(_));
-                    let id = self.sim.handle.send(cmd);
-                    if shown {
-                        self.ui.params_sent(id);
-                    }
-                }
+                Action::Sim(cmd) => self.sim.command(cmd, &mut self.ui),
                 Action::Screenshot => self.capture.screenshot_view(&self.gpu, &mut self.ui, size),
                 Action::ToggleRecord => {
                     let samples = self.view.renderer.samples();
@@ -380,10 +348,7 @@ impl Viewer {
                 }
             }
         }
-        if let Some(p) = self.ui.param_change() {
-            let id = self.sim.handle.send(Command::SetParams(Box::new(p)));
-            self.ui.params_sent(id);
-        }
+        self.sim.send_params(&mut self.ui);
     }
 
     /// Step 3: the surface texture to draw into; `None` skips this frame (and schedules the
@@ -413,15 +378,8 @@ impl Viewer {
 
     /// Step 4: fits the view texture to the view's rectangle and draws the scene into it.
     fn draw_view(&mut self, encoder: &mut wgpu::CommandEncoder, pixels_per_point: f32) {
-        let r = self.ui.view_rect;
-        let (vw, vh) = if r.is_positive() {
-            (
-                (r.width() * pixels_per_point).round().max(1.0) as u32,
-                (r.height() * pixels_per_point).round().max(1.0) as u32,
-            )
-        } else {
-            (1, 1)
-        };
+        self.draw_view_b(encoder, pixels_per_point);
+        let (vw, vh) = pixels(self.ui.view_rect, pixels_per_point);
         self.view.resize(&self.gpu, &mut self.egui.painter, vw, vh);
         let Some(scene) = &self.ui.scene else {
             return;
@@ -433,6 +391,27 @@ impl Viewer {
             .draw(&self.gpu, encoder, scene, &camera, self.ui.scene_version);
         if let Err(e) = drawn {
             self.ui.error(format!("cannot draw this step: {e}"));
+        }
+    }
+
+    /// Step 4 for run B of a comparison: its pane, with the same camera as A's.
+    fn draw_view_b(&mut self, encoder: &mut wgpu::CommandEncoder, pixels_per_point: f32) {
+        let (Some(view), Some(c)) = (self.view_b.as_mut(), self.ui.compare.as_deref()) else {
+            return;
+        };
+        if c.ghost {
+            return; // B is drawn by egui over A's pane
+        }
+        let (vw, vh) = pixels(c.view_rect_b, pixels_per_point);
+        view.resize(&self.gpu, &mut self.egui.painter, vw, vh);
+        let Some(scene) = &c.scene_b else {
+            return;
+        };
+        let mut camera = self.ui.view.camera.clone();
+        camera.aspect = vw as f32 / vh as f32;
+        let drawn = view.draw(&self.gpu, encoder, scene, &camera, c.scene_b_version);
+        if let Err(e) = drawn {
+            self.ui.error(format!("cannot draw this step of B: {e}"));
         }
     }
 
@@ -518,7 +497,7 @@ impl Viewer {
         }
     }
 
-    /// The `--exit-after-frames` report.
+    /// The `--exit-after-frames` report (with B's solver speed in a comparison).
     fn report(&self) {
         self.clock.report(
             &self.ui.perf.all_intervals,
@@ -527,5 +506,20 @@ impl Viewer {
             self.view.size,
             &self.ui.adapter,
         );
+        if let Some(b) = SimLink::frame_b(&self.ui) {
+            timing::report_b(&b);
+        }
+    }
+}
+
+/// A rectangle in points as a texture size in pixels (at least 1×1).
+fn pixels(r: egui::Rect, pixels_per_point: f32) -> (u32, u32) {
+    if r.is_positive() {
+        (
+            (r.width() * pixels_per_point).round().max(1.0) as u32,
+            (r.height() * pixels_per_point).round().max(1.0) as u32,
+        )
+    } else {
+        (1, 1)
     }
 }

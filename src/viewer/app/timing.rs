@@ -162,6 +162,26 @@ impl FrameClock {
     }
 }
 
+/// The exit report's line for run B of a comparison: its solver's speed (the frame times and
+/// A's solver are on the line before).
+pub(super) fn report_b(b: &Frame) {
+    let (steps, run_s) = (b.totals.steps, b.running_seconds);
+    eprintln!(
+        "viewer: compare run B ({}): solver {} steps to t = {:.3} s in {:.2} s running: {:.0} \
+         steps/s (last 0.5 s: {:.0} steps/s)",
+        b.params.method.as_str(),
+        steps,
+        b.snapshot.time,
+        run_s,
+        if run_s > 0.0 {
+            steps as f64 / run_s
+        } else {
+            0.0
+        },
+        b.steps_per_second
+    );
+}
+
 /// Phase timings of a frame, printed when `DDA3D_VIEWER_TIMING` is set (for tuning).
 pub(super) struct Timing {
     pub on: bool,

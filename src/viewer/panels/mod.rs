@@ -1,11 +1,16 @@
 //! The viewer's panels, one file each (after egui's demo app): the [`toolbar`], the left column
 //! ([`solver`] parameters, [`display`] options, [`selection`] details, [`run`] statistics), the
-//! [`plots`] at the bottom and the [`view_3d`] in the middle, plus the keyboard shortcuts. Each
+//! [`plots`] at the bottom and the [`view_3d`] in the middle, plus the keyboard shortcuts. In a
+//! comparison, [`compare_target`] picks the run the solver panel edits and [`compare_plots`]
+//! replaces the plots. Each
 //! panel is a `show` function that draws from and edits [`UiState`] and pushes the [`Action`]s
 //! the app must carry out. No GPU code here: the 3-D image arrives as an egui texture id and is
 //! drawn by [`super::app`].
 
+mod compare_plots;
+mod compare_target;
 mod display;
+mod ghost;
 mod plots;
 mod run;
 mod selection;
@@ -25,6 +30,7 @@ use widgets::ERROR_RED;
 pub fn build(ui: &mut egui::Ui, state: &mut UiState, view_texture: egui::TextureId) -> Vec<Action> {
     let mut actions = Vec::new();
     state.build_scene();
+    state.build_scene_b();
     // Panels are not filled: the window is cleared to the panel colour, and on a software
     // rasterizer every filled pixel counts (about a third of the frame time).
     let panel = |m: egui::Margin| egui::Frame::new().inner_margin(m);
@@ -37,7 +43,13 @@ pub fn build(ui: &mut egui::Ui, state: &mut UiState, view_texture: egui::Texture
             .resizable(true)
             .default_size(190.0)
             .min_size(120.0)
-            .show(ui, |ui| plots::show(ui, state));
+            .show(ui, |ui| {
+                if state.compare.is_some() {
+                    compare_plots::show(ui, state);
+                } else {
+                    plots::show(ui, state);
+                }
+            });
     }
     egui::Panel::left("controls")
         .frame(panel(egui::Margin::symmetric(8, 2)))
@@ -52,7 +64,10 @@ pub fn build(ui: &mut egui::Ui, state: &mut UiState, view_texture: egui::Texture
                 }
                 egui::CollapsingHeader::new(RichText::new("Solver").strong())
                     .default_open(true)
-                    .show(ui, |ui| solver::show(ui, state));
+                    .show(ui, |ui| {
+                        compare_target::show(ui, state);
+                        solver::show(ui, state);
+                    });
                 egui::CollapsingHeader::new(RichText::new("Display").strong())
                     .default_open(true)
                     .show(ui, |ui| display::show(ui, state));

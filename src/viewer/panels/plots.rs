@@ -13,7 +13,7 @@ use crate::viewer::state::UiState;
 /// Points per plotted line: about one per pixel of a plot's width. Each point becomes several
 /// anti-aliased triangles, and on a software rasterizer triangles, not pixels, dominate the cost
 /// of the plots.
-const PLOT_POINTS: usize = 240;
+pub(super) const PLOT_POINTS: usize = 240;
 
 pub fn show(ui: &mut egui::Ui, state: &UiState) {
     let recs = &state.history.records;
@@ -37,7 +37,7 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
 
 /// Downsamples `records` to at most `PLOT_POINTS` buckets, applying `reduce` to each bucket's
 /// values (max for peaks so a spike is never hidden).
-fn series(
+pub(super) fn series(
     records: &[StepRecord],
     value: impl Fn(&StepRecord) -> f64,
     reduce: fn(f64, f64) -> f64,
@@ -60,7 +60,7 @@ fn series(
         .collect()
 }
 
-fn plot_title(ui: &mut egui::Ui, title: &str, tip: &str) {
+pub(super) fn plot_title(ui: &mut egui::Ui, title: &str, tip: &str) {
     ui.label(RichText::new(title).strong().size(13.0))
         .on_hover_text(tip);
 }
@@ -72,7 +72,7 @@ fn limit_line(name: &str, y: f64) -> HLine {
         .color(Color32::from_gray(110))
 }
 
-fn small_plot<'a>(id: &str, height: f32) -> Plot<'a> {
+pub(super) fn small_plot<'a>(id: &str, height: f32) -> Plot<'a> {
     Plot::new(id)
         .height(height)
         .allow_zoom(false)

@@ -15,11 +15,23 @@ use crate::viewer::state::UiState;
 use crate::viewer::view::DragButton;
 
 pub fn show(ui: &mut egui::Ui, state: &mut UiState, texture: egui::TextureId) {
-    let rect = ui.max_rect();
+    let full = ui.max_rect();
+    // A comparison splits the view into two panes, A left and B right, seen by one camera:
+    // one response over both, so orbit and zoom in either pane move both.
+    let split = state.compare.as_deref().is_some_and(|c| !c.ghost);
+    let (rect, rect_b) = if split {
+        let (l, r) = full.split_left_right_at_fraction(0.5);
+        (l, Some(r.shrink2(Vec2::new(1.0, 0.0))))
+    } else {
+        (full, None)
+    };
     state.view_rect = rect;
     state.view.set_viewport(rect.width(), rect.height());
-    let response = ui.allocate_rect(rect, Sense::click_and_drag());
-    camera_input(ui, state, &response, rect);
+    let response = ui.allocate_rect(full, Sense::click_and_drag());
+    camera_input(ui, state, &response, rect, rect_b);
+    if let Some(rb) = rect_b {
+        pane_b(ui, state, rb);
+    }
 
     let painter = ui.painter_at(rect);
     painter.image(
@@ -46,6 +58,11 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState, texture: egui::TextureId) {
         block_labels(&painter, rect, snap, state.selected, &to_screen);
     }
 
+    if let Some(b) = state.compare.as_deref().filter(|c| c.ghost)
+        && let Some(fb) = &b.frame_b
+    {
+        super::ghost::paint(&painter, state, &fb.snapshot, rect);
+    }
     if let Some(scene) = &state.scene
         && scene.overlay
     {
@@ -64,8 +81,52 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState, texture: egui::TextureId) {
     }
 }
 
-/// Orbit, pan and zoom the camera, and select the block under a click.
-fn camera_input(ui: &egui::Ui, state: &mut UiState, response: &egui::Response, rect: Rect) {
+/// Run B's pane of a comparison: its image, the selected block's outline and the overlay.
+fn pane_b(ui: &egui::Ui, state: &mut UiState, rect: Rect) {
+    let Some(c) = state.compare.as_deref_mut() else {
+        return;
+    };
+    c.view_rect_b = rect;
+    let painter = ui.painter_at(rect);
+    if let Some(t) = c.texture_b {
+        let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
+        painter.image(t, rect, uv, Color32::WHITE);
+    }
+    let divider = [rect.left_top() - Vec2::X, rect.left_bottom() - Vec2::X];
+    painter.line_segment(divider, Stroke::new(2.0, Color32::from_gray(90)));
+    let Some(frame) = c.frame_b.clone() else {
+        return;
+    };
+    let snap = &frame.snapshot;
+    let (w, h) = (rect.width(), rect.height());
+    let to_screen = |p: [f64; 3]| {
+        state
+            .view
+            .project(p, w, h)
+            .map(|(x, y)| rect.min + Vec2::new(x, y))
+    };
+    if let Some(b) = state.selected.and_then(|i| snap.blocks.get(i)) {
+        outline(&painter, b, &to_screen);
+    }
+    if state.display.labels {
+        block_labels(&painter, rect, snap, state.selected, &to_screen);
+    }
+    if let Some(scene) = &c.scene_b
+        && scene.overlay
+    {
+        paint_overlay(&painter, scene, &state.view.camera, rect);
+    }
+}
+
+/// Orbit, pan and zoom the camera, and select the block under a click (in either pane of a
+/// comparison, on that pane's run).
+fn camera_input(
+    ui: &egui::Ui,
+    state: &mut UiState,
+    response: &egui::Response,
+    rect: Rect,
+    rect_b: Option<Rect>,
+) {
     let (w, h) = (rect.width(), rect.height());
     let delta = response.drag_delta();
     if response.dragged_by(PointerButton::Primary) {
@@ -81,10 +142,18 @@ fn camera_input(ui: &egui::Ui, state: &mut UiState, response: &egui::Response, r
             state.view.scroll(scroll);
         }
     }
-    if response.clicked()
-        && let (Some(pos), Some(f)) = (response.interact_pointer_pos(), &state.frame)
-    {
-        let p = pos - rect.min;
+    let Some(pos) = response
+        .interact_pointer_pos()
+        .filter(|_| response.clicked())
+    else {
+        return;
+    };
+    let (pane, frame) = match (rect_b, state.compare.as_deref()) {
+        (Some(rb), Some(c)) if rb.contains(pos) => (rb, c.frame_b.clone()),
+        _ => (rect, state.frame.clone()),
+    };
+    if let Some(f) = frame {
+        let p = pos - pane.min;
         state.selected = state.view.pick(&f.snapshot, p.x, p.y, w, h);
     }
 }

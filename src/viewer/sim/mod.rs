@@ -19,8 +19,10 @@
 //! - `protocol.rs`: what travels between the two sides ([`Command`], [`Frame`], [`StepRecord`],
 //!   [`RunState`], [`Speed`]);
 //! - `thread.rs`: the simulation thread itself (stepping, pacing, publishing);
+//! - [`pair`]: two threads in lock-step of simulated time (`view --compare`);
 //! - this file: the window's end, [`SimHandle`], and the mailbox the two sides share.
 
+pub mod pair;
 mod protocol;
 pub mod states;
 mod thread;

@@ -37,6 +37,10 @@ pub enum Command {
     /// Rejected with a message when [`SolverParams::validate`] fails.
     SetParams(Box<SolverParams>),
     SetSpeed(Speed),
+    /// Never step past this simulated time (None: no limit). A running thread that reaches it
+    /// lands exactly on it (its last step is shortened) and holds there, still Running, until
+    /// the limit moves: how the two runs of a comparison keep in lock-step of simulated time.
+    SetLimit(Option<f64>),
     /// Save the solver's state as `DIR/checkpoint_<t>.ckpt` (the format of `run
     /// --checkpoint-every`).
     SaveState(PathBuf),

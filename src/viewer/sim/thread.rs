@@ -20,6 +20,8 @@ const MAILBOX_RECORD_CAP: usize = 200_000;
 /// Publications while running are at most this often: enough for any display, and cheap
 /// even for large models whose snapshots take a while to copy.
 const PUBLISH_INTERVAL: Duration = Duration::from_micros(8_333);
+/// Relative distance from a step limit that counts as on it (rounding of `t + (limit - t)`).
+const LIMIT_SNAP: f64 = 1e-12;
 /// Window over which steps per second are measured.
 const RATE_WINDOW: Duration = Duration::from_millis(500);
 
@@ -81,6 +83,8 @@ struct Sim {
     notice: Option<(u64, String)>,
     /// A single step was requested while paused.
     step_once: bool,
+    /// See [`Command::SetLimit`].
+    limit: Option<f64>,
     applied: u64,
     generation: u64,
     seq: u64,
@@ -123,6 +127,7 @@ impl Sim {
             error: None,
             notice: None,
             step_once: false,
+            limit: None,
             applied: 0,
             generation: 0,
             seq: 0,
@@ -195,7 +200,9 @@ impl Sim {
     }
 
     fn wants_step(&self) -> bool {
-        (self.state == RunState::Running || self.step_once) && !self.solver.finished()
+        (self.state == RunState::Running || self.step_once)
+            && !self.solver.finished()
+            && self.limit.is_none_or(|t| self.solver.time < t)
     }
 
     /// How long to sleep before the next step to keep to the real-time factor (None: step now).
@@ -302,6 +309,7 @@ impl Sim {
                 }
                 Err(m) => self.error = Some(format!("{REJECTED}: {m}")),
             },
+            Command::SetLimit(t) => self.limit = t,
             Command::SetSpeed(s) => {
                 self.speed = s;
                 self.re_anchor();
@@ -331,7 +339,19 @@ impl Sim {
     fn do_step(&mut self) {
         self.step_once = false;
         let t0 = Instant::now();
-        let result = self.solver.step().cloned();
+        let result = match self.limit {
+            Some(limit) => self.solver.step_until(limit).cloned(),
+            None => self.solver.step().cloned(),
+        };
+        if let Some(limit) = self.limit
+            && (self.solver.time - limit).abs() <= LIMIT_SNAP * limit.abs().max(1.0)
+        {
+            // A step shortened to end on the limit lands within rounding of it; both sides of
+            // a comparison must show the very same t, so the last bits are made equal.
+            self.solver.time = limit;
+            // Publish at once: the window hands out the next limit when both sides are here.
+            self.dirty = true;
+        }
         let busy = t0.elapsed();
         match result {
             Ok(stats) => {

@@ -1,0 +1,122 @@
+//! `dda3d render SCENE --compare METHOD` (or `--compare-set`): runs A (the scene's settings)
+//! and B (derived) to every frame time in turn, each with its own steps shortened to land on
+//! the frame time, and hands both snapshots to the capture as one side-by-side frame: A left,
+//! B right, one camera, each half captioned with its side and the settings that differ.
+//! frames.csv lists both sides' times and steps.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use super::Progress;
+use super::exit::{self, Failure};
+use super::render::{RenderArgs, Simulated, capture_failure, capture_options, write_summary};
+use crate::compare::{CompareSpec, caption, labels};
+use crate::output::slug;
+use crate::render::{FrameCapture, RenderError};
+use crate::scene::Scene;
+use crate::solver::Solver;
+use crate::text::short;
+
+/// `render --compare`: as `render`, with two runs in each frame.
+pub(super) fn execute(args: &RenderArgs, scene: Scene, spec: &CompareSpec) -> Result<(), Failure> {
+    let params_b = spec
+        .derive(&scene.params)
+        .map_err(|e| Failure::Input(e.to_string()))?;
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)).join("frames"));
+    let mut opts = capture_options(args, &out)?;
+    let (la, lb) = labels(&scene.params, &params_b);
+    opts.sides = Some([
+        caption("A", &scene.params, &la),
+        caption("B", &params_b, &lb),
+    ]);
+    let name = scene.name.clone();
+    let mut a = Solver::new(scene.model.clone(), scene.params);
+    let mut b = Solver::new(scene.model, params_b);
+    exit::catch_stop_signals()?;
+    let capture = FrameCapture::start(opts).map_err(|e| capture_failure(&out, e))?;
+    let start = Instant::now();
+    let simulated =
+        simulate_pairs(&mut a, &mut b, &capture, args).map_err(|e| capture_failure(&out, e))?;
+    let report = capture.finish().map_err(|e| capture_failure(&out, e))?;
+    let wall = start.elapsed().as_secs_f64();
+    write_summary(&out, &name, args, &report, &simulated, wall)?;
+    let reached = format!(
+        "{} side-by-side frames up to t = {} s are in {}",
+        report.frames,
+        short(a.time.min(b.time)),
+        out.display()
+    );
+    if let Some(e) = simulated.failure {
+        return Err(Failure::Diverged(format!(
+            "{}: {e}; {reached}",
+            args.scene.display()
+        )));
+    }
+    if let Some(signal) = simulated.interrupted {
+        return Err(Failure::Interrupted(
+            signal,
+            format!("{}; {reached}", signal.name()),
+        ));
+    }
+    if !args.quiet {
+        eprintln!(
+            "{name}: {} side-by-side frames in {} s ({} frames/s; simulation of A and B {} s, render+readback {} ms/frame, PNG {} ms/frame on {}); frames in {}",
+            report.frames,
+            short(wall),
+            short(report.frames as f64 / wall),
+            short(simulated.seconds),
+            short(report.render_ms_per_frame()),
+            short(report.encode_ms_per_frame()),
+            report.adapter,
+            out.display()
+        );
+    }
+    Ok(())
+}
+
+/// Steps both solvers to each frame time in turn and submits the pair there, frame 0
+/// included. Either run's failure ends both early (a half with nothing to show would not
+/// compare); a capture failure is the error.
+fn simulate_pairs(
+    a: &mut Solver,
+    b: &mut Solver,
+    capture: &FrameCapture,
+    args: &RenderArgs,
+) -> Result<Simulated, RenderError> {
+    let mut seconds = 0.0;
+    let frame_dt = 1.0 / args.fps;
+    let duration = a.params.duration.min(b.params.duration);
+    let total_frames = (duration * args.fps + 1e-9).floor() as u64 + 1;
+    let mut progress = Progress::new(duration, args.quiet);
+    capture.submit_pair(a.snapshot(), b.snapshot())?;
+    let (mut failure, mut interrupted) = (None, None);
+    'frames: for k in 1..total_frames {
+        let t = k as f64 * frame_dt;
+        for solver in [&mut *a, &mut *b] {
+            while solver.time < t - 1e-9 * frame_dt {
+                interrupted = exit::interrupted();
+                if interrupted.is_some() {
+                    break 'frames;
+                }
+                let ts = Instant::now();
+                let r = solver.step_until(t);
+                seconds += ts.elapsed().as_secs_f64();
+                if let Err(e) = r {
+                    failure = Some(e);
+                    break 'frames;
+                }
+            }
+        }
+        capture.submit_pair(a.snapshot(), b.snapshot())?;
+        progress.update(a.time);
+    }
+    progress.finish();
+    Ok(Simulated {
+        seconds,
+        failure,
+        interrupted,
+    })
+}

@@ -1,0 +1,118 @@
+//! The lock-step protocol of a comparison: every pair of frames the window is given has one t,
+//! and a change sent to one side reaches that side only.
+
+use super::*;
+use crate::compare::CompareSpec;
+
+fn rockfall() -> crate::scene::Scene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join("rock_column_rockfall.toml");
+    crate::scene::load(&path).expect("shipped scene loads")
+}
+
+/// The rockfall, A as the scene says (ALM), B with the penalty method.
+fn spawn(speed: Speed, play: bool) -> SimPair {
+    let s = rockfall();
+    let spec = CompareSpec::parse(Some("penalty"), None).unwrap().unwrap();
+    let b = spec.derive(&s.params).unwrap();
+    SimPair::spawn(s.model, s.params, b, speed, play, || {}).unwrap()
+}
+
+const WAIT: Duration = Duration::from_secs(60);
+
+#[test]
+fn every_shown_pair_has_one_time_through_the_impact() {
+    let mut pair = spawn(Speed::Max, true);
+    let mut times = Vec::new();
+    let (a, b) = pair
+        .wait_for(WAIT, |a, b| {
+            assert_eq!(
+                a.snapshot.time.to_bits(),
+                b.snapshot.time.to_bits(),
+                "A at {} and B at {}",
+                a.snapshot.time,
+                b.snapshot.time
+            );
+            if times.last() != Some(&a.snapshot.time) {
+                times.push(a.snapshot.time);
+            }
+            a.snapshot.time >= 0.3
+        })
+        .expect("both reach 0.3 s");
+    assert!(
+        times.len() >= 10,
+        "the pair moved on in small steps: {times:?}"
+    );
+    // Each run keeps its own steps: the two methods do not step alike through the impact.
+    assert_eq!(a.params.method, crate::params::Method::Alm);
+    assert_eq!(b.params.method, crate::params::Method::Penalty);
+    let d = crate::compare::compare_snapshots(&a.snapshot, &b.snapshot);
+    assert!(d.max_displacement_difference.is_finite());
+}
+
+#[test]
+fn pause_holds_both_on_one_time_and_step_moves_both() {
+    let mut pair = spawn(Speed::Max, true);
+    pair.wait_for(WAIT, |a, _| a.snapshot.time >= 0.05).unwrap();
+    pair.command(Command::Pause);
+    let (a, b) = pair
+        .wait_for(WAIT, |a, b| {
+            a.state == RunState::Paused && b.state == RunState::Paused
+        })
+        .expect("both pause");
+    assert_eq!(a.snapshot.time.to_bits(), b.snapshot.time.to_bits());
+    assert!(!pair.playing());
+    let t = a.snapshot.time;
+    pair.command(Command::Step);
+    let (a2, b2) = pair
+        .wait_for(WAIT, |a, b| {
+            a.snapshot.time > t && a.state == RunState::Paused && b.state == RunState::Paused
+        })
+        .expect("a step on");
+    assert_eq!(a2.snapshot.time.to_bits(), b2.snapshot.time.to_bits());
+    assert!((a2.snapshot.time - t - a2.params.max_time_step).abs() < 1e-12);
+    pair.command(Command::Reset);
+    let (a, b) = pair
+        .wait_for(WAIT, |a, b| {
+            a.snapshot.step == 0 && b.snapshot.step == 0 && a.generation > 0
+        })
+        .expect("both back at t = 0");
+    assert_eq!(a.snapshot.time, 0.0);
+    assert_eq!(b.generation, a.generation);
+}
+
+#[test]
+fn a_parameter_change_sent_to_b_alone_reaches_b_and_not_a() {
+    let mut pair = spawn(Speed::Max, false);
+    let before = pair.tick();
+    let mut p = before.1.params.clone();
+    p.contact.alpha = 7.5;
+    p.joint.friction_angle = 20.0;
+    let id = pair
+        .side(Side::B)
+        .send(Command::SetParams(Box::new(p.clone())));
+    // B's next frame carries the change; A's frames never do.
+    let fb = pair
+        .b
+        .wait_for(WAIT, |f| f.applied >= id)
+        .expect("B takes it");
+    assert_eq!(fb.params, p);
+    let fa = pair.a.latest().unwrap();
+    assert_eq!(fa.params, before.0.params, "A keeps its parameters");
+    // And so do the frames the window is shown after the next step.
+    pair.command(Command::Step);
+    let (a, b) = pair
+        .wait_for(WAIT, |a, b| {
+            a.snapshot.step >= 1 && b.snapshot.step >= 1 && a.state == RunState::Paused
+        })
+        .expect("steps");
+    assert_eq!(b.params.contact.alpha, 7.5);
+    assert_eq!(b.params.joint.friction_angle, 20.0);
+    assert_eq!(a.params.contact.alpha, before.0.params.contact.alpha);
+    assert_eq!(
+        a.params.joint.friction_angle,
+        before.0.params.joint.friction_angle
+    );
+    assert_eq!(a.snapshot.time.to_bits(), b.snapshot.time.to_bits());
+}
