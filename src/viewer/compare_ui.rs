@@ -35,9 +35,9 @@ pub struct CompareUi {
     pub b_sent: u64,
     /// The settings that differ, `name=value`, of A and of B.
     pub labels: (Vec<String>, Vec<String>),
-    /// (t, largest block displacement difference between A and B, m), one point per common
-    /// time the window was shown.
-    pub difference: Vec<[f64; 2]>,
+    /// (t, largest block displacement difference between A and B in m, difference of their
+    /// total contact force in N), one point per common time the window was shown.
+    pub difference: Vec<[f64; 3]>,
     /// The 3-D view's texture of B (the app's second view target) and its rectangle in points.
     pub texture_b: Option<egui::TextureId>,
     pub view_rect_b: egui::Rect,
@@ -91,7 +91,8 @@ impl UiState {
             }
             if c.difference.last().is_none_or(|p| p[0] < t) {
                 let d = compare_snapshots(&fa.snapshot, &fb.snapshot);
-                c.difference.push([t, d.max_displacement_difference]);
+                c.difference
+                    .push([t, d.max_displacement_difference, d.contact_force_difference]);
                 if c.difference.len() > DIFFERENCE_CAP {
                     c.difference.drain(..c.difference.len() - DIFFERENCE_CAP);
                 }
@@ -250,7 +251,7 @@ mod tests {
         assert_eq!(c.labels.1, vec!["method=penalty".to_owned()]);
         assert_eq!(
             c.difference,
-            vec![[0.0, 0.0]],
+            vec![[0.0, 0.0, 0.0]],
             "one common time, no difference yet"
         );
         st.set_edit_target(EditTarget::B);

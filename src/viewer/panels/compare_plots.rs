@@ -1,6 +1,7 @@
-//! The plots of a comparison: run A's and run B's maximum penetration, kinetic energy and
-//! contacts over one time axis, and the largest block displacement difference between A and
-//! B at the common times the panes showed.
+//! The plots of a comparison: run A's and run B's maximum penetration, kinetic energy, ALM
+//! solves per step and largest penalty over one time axis, and at the common times the panes
+//! showed the largest block displacement difference and the difference of total contact force
+//! between A and B.
 
 use egui::Color32;
 use egui_plot::{Line, LineStyle, PlotPoints};
@@ -20,7 +21,7 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
     let (a, b) = (&state.history.records[..], &c.history_b.records[..]);
     let h = (ui.available_height() - 22.0).max(60.0);
     ui.add_space(2.0);
-    ui.columns(4, |cols| {
+    ui.columns(6, |cols| {
         overlay(
             &mut cols[0],
             ("Max penetration (mm)", "pen_ab"),
@@ -39,13 +40,48 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
         );
         overlay(
             &mut cols[2],
-            ("Closed contacts", "contacts_ab"),
-            "Contacts in the lock or slide state after each step, run A and run B.",
+            ("ALM solves / step", "solves_ab"),
+            "Linear solves of each step (all ALM iterations of all open–close passes; one per \
+             pass for the penalty method), run A and run B.",
             (a, b),
-            |r| (r.lock + r.slide) as f64,
+            |r| f64::from(r.alm_iterations),
             h,
         );
-        difference(&mut cols[3], &c.difference, h);
+        overlay(
+            &mut cols[3],
+            ("Largest p_n (log10 N/m)", "pn_ab"),
+            "The largest normal penalty over the closed contacts after each step, run A and run \
+             B: the ALM raises it (P21) where penetration converges slowly.",
+            (a, b),
+            |r| r.penalty_max.log10(),
+            h,
+        );
+        difference(
+            &mut cols[4],
+            (
+                "|u_A − u_B| max (mm)",
+                "diff_ab",
+                "The largest distance between a block's centroid in run A and in run B at the \
+                 same simulated time (the runs start from the same scene, so their \
+                 displacements differ by exactly this).",
+            ),
+            &c.difference,
+            |p| p[1] * 1e3,
+            h,
+        );
+        difference(
+            &mut cols[5],
+            (
+                "|ΣF_A − ΣF_B| (kN)",
+                "force_ab",
+                "The difference of the total contact force of run A and run B at the same \
+                 simulated time (each total: the sum over closed contacts of the force's \
+                 magnitude).",
+            ),
+            &c.difference,
+            |p| p[2] * 1e-3,
+            h,
+        );
     });
 }
 
@@ -75,28 +111,28 @@ fn overlay(
     });
 }
 
-/// The largest block displacement difference between A and B, mm, at the common times shown.
-fn difference(ui: &mut egui::Ui, points: &[[f64; 2]], h: f32) {
-    plot_title(
-        ui,
-        "|u_A − u_B| max (mm)",
-        "The largest distance between a block's centroid in run A and in run B at the same \
-         simulated time (the runs start from the same scene, so their displacements differ \
-         by exactly this).",
-    );
+/// One difference between A and B at the common times shown (`value` of each point).
+fn difference(
+    ui: &mut egui::Ui,
+    (title, id, tip): (&str, &str, &str),
+    points: &[[f64; 3]],
+    value: impl Fn(&[f64; 3]) -> f64,
+    h: f32,
+) {
+    plot_title(ui, title, tip);
     let per = points.len().div_ceil(super::plots::PLOT_POINTS).max(1);
     let pts: Vec<[f64; 2]> = points
         .chunks(per)
         .filter_map(|c| {
             let v = c
                 .iter()
-                .map(|p| p[1])
+                .map(&value)
                 .filter(|v| v.is_finite())
                 .reduce(f64::max)?;
-            Some([c[c.len() - 1][0], v * 1e3])
+            Some([c[c.len() - 1][0], v])
         })
         .collect();
-    small_plot("diff_ab", h).show(ui, |p| {
+    small_plot(id, h).show(ui, |p| {
         p.line(
             Line::new("A − B", PlotPoints::from(pts))
                 .color(Color32::from_rgb(0x6A, 0x3D, 0x9A))
