@@ -194,6 +194,19 @@ fn bad_compare_specs_are_one_line_errors_with_status_2() {
             assert!(err.starts_with("error: --compare"), "{err}");
         }
     }
+    // A block to select that the scene does not have, likewise.
+    let out = bin()
+        .arg("view")
+        .arg(rockfall())
+        .args(["--compare", "penalty", "--select", "no such block"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(err.starts_with("error: --select"), "{err}");
 }
 
 #[test]

@@ -54,6 +54,10 @@ pub struct ViewArgs {
     /// above the solver panel switches back to two panes).
     #[arg(long)]
     pub ghost: bool,
+    /// Open with this block selected (its name, as in blocks.csv): its card and contacts show
+    /// from the first frame, in both runs of a comparison.
+    #[arg(long, value_name = "BLOCK")]
+    pub select: Option<String>,
 }
 
 /// Frames rendered before `--screenshot` is taken when `--exit-after-frames` is not given:
@@ -111,6 +115,19 @@ pub fn view(args: &ViewArgs) -> Result<(), CliError> {
             "--ghost draws run B over run A: add --compare or --compare-set".into(),
         ));
     }
+    let selected = match &args.select {
+        None => None,
+        Some(name) => Some(
+            scene
+                .model
+                .blocks
+                .iter()
+                .position(|b| &b.name == name)
+                .ok_or_else(|| {
+                    CliError::Input(format!("--select: the scene has no block named {name:?}"))
+                })?,
+        ),
+    };
     if let Some(n) = args.msaa
         && !matches!(n, 1 | 4)
     {
@@ -149,6 +166,7 @@ pub fn view(args: &ViewArgs) -> Result<(), CliError> {
         out_dir,
         ghost: args.ghost,
         compare,
+        selected,
     })?;
     Ok(())
 }

@@ -49,6 +49,8 @@ pub struct ViewerOptions {
     pub compare: Option<crate::params::SolverParams>,
     /// Open a comparison in one pane, B as a ghost over A.
     pub ghost: bool,
+    /// The block selected at start (`--select`).
+    pub selected: Option<usize>,
 }
 
 /// Why the viewer could not run or stopped, as one line.

@@ -211,6 +211,7 @@ impl Viewer {
             .ok_or_else(|| ViewerError::Failed("the simulation published no state".into()))?;
         let mut ui = UiState::new(&opts.scene, &first.snapshot, adapter);
         ui.out_dir = opts.out_dir.clone();
+        ui.selected = opts.selected;
         ui.compare = sim.compare_ui(&opts);
         let view_b = ui.compare.as_mut().map(|c| {
             let v = ViewTarget::new(&gpu, &mut egui.painter, samples);

@@ -25,13 +25,29 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
         state.scene_file.blocks.get(i),
         &snap.rock_masses,
     );
+    // In a comparison, the block's contacts in both runs at the same time, A's first.
+    let b = state
+        .compare
+        .as_deref()
+        .and_then(|c| c.frame_b.clone())
+        .filter(|fb| i < fb.snapshot.blocks.len());
+    let heading_a = if b.is_some() { "Run A: " } else { "" };
+    contact_table(ui, snap, i, state.scene_file.young, heading_a);
+    if let Some(fb) = b {
+        ui.add_space(6.0);
+        contact_table(ui, &fb.snapshot, i, state.scene_file.young, "Run B: ");
+    }
+}
+
+/// The closed contacts of block `i` in `snap`, under a heading that starts with `side`.
+fn contact_table(ui: &mut egui::Ui, snap: &Snapshot, i: usize, young: f64, side: &str) {
     let contacts: Vec<_> = snap
         .contacts
         .iter()
         .filter(|c| c.block_i == i || c.block_j == i)
         .collect();
     ui.add_space(4.0);
-    ui.label(RichText::new(format!("{} closed contacts", contacts.len())).strong());
+    ui.label(RichText::new(format!("{side}{} closed contacts", contacts.len())).strong());
     if contacts.is_empty() {
         return;
     }
@@ -42,10 +58,10 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
             .small(),
     );
     egui::ScrollArea::vertical()
-        .id_salt("sel_contacts")
+        .id_salt(("sel_contacts", side))
         .max_height(220.0)
         .show(ui, |ui| {
-            egui::Grid::new("sel_contacts_grid")
+            egui::Grid::new(("sel_contacts_grid", side))
                 .num_columns(7)
                 .striped(true)
                 .spacing([8.0, 2.0])
@@ -55,7 +71,7 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
                     }
                     ui.end_row();
                     for c in contacts.iter().take(200) {
-                        contact_row(ui, snap, i, c, state.scene_file.young);
+                        contact_row(ui, snap, i, c, young);
                         ui.end_row();
                     }
                 });
