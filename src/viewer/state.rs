@@ -26,6 +26,9 @@ pub enum Action {
     Screenshot,
     /// Start or stop writing PNG frames.
     ToggleRecord,
+    /// Start a comparison with run B's settings (both runs from t = 0, paused), or end it
+    /// (`None`: run A alone from t = 0).
+    Compare(Option<Box<SolverParams>>),
 }
 
 /// Display options of the 3-D view.

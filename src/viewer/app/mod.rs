@@ -185,6 +185,10 @@ struct Viewer {
     ui: UiState,
     capture: Capture,
     clock: FrameClock,
+    /// The scene as loaded and the event loop's waker: a comparison started or ended from the
+    /// panel restarts the simulation threads from them.
+    scene: crate::scene::Scene,
+    proxy: EventLoopProxy<Wake>,
 }
 
 impl Viewer {
@@ -226,8 +230,10 @@ impl Viewer {
             view_b,
             sim,
             ui,
-            capture: Capture::new(opts.out_dir, opts.screenshot, proxy),
+            capture: Capture::new(opts.out_dir, opts.screenshot, proxy.clone()),
             clock: FrameClock::new(opts.exit_after_frames, software),
+            scene: opts.scene,
+            proxy,
         })
     }
 
@@ -347,9 +353,48 @@ impl Viewer {
                     self.capture
                         .toggle_record(&self.gpu, &mut self.ui, size, samples);
                 }
+                Action::Compare(b) => self.set_compare(b.map(|b| *b)),
             }
         }
         self.sim.send_params(&mut self.ui);
+    }
+
+    /// Starts a comparison with run B's settings `b`, or ends it (`None`): the simulation
+    /// restarts from t = 0, paused, with run A's present settings.
+    fn set_compare(&mut self, b: Option<crate::params::SolverParams>) {
+        let mut scene = self.scene.clone();
+        if let Some(f) = self.ui.frame.as_ref() {
+            scene.params = f.params.clone();
+        }
+        let opts = ViewerOptions {
+            scene,
+            size: self.window_size(),
+            speed: self.ui.speed,
+            play: false,
+            screenshot: None,
+            exit_after_frames: None,
+            msaa: None,
+            out_dir: self.ui.out_dir.clone(),
+            compare: b,
+            ghost: false,
+            selected: self.ui.selected,
+        };
+        let sim = match SimLink::start(&opts, self.proxy.clone()) {
+            Ok(sim) => sim,
+            Err(e) => return self.ui.error(e.to_string()),
+        };
+        // The old threads stop as their handles drop; the plots start over.
+        self.sim = sim;
+        self.ui.frame = None;
+        self.ui.history = Default::default();
+        self.ui.compare = self.sim.compare_ui(&opts);
+        let samples = self.view.renderer.samples();
+        self.view_b = self.ui.compare.as_mut().map(|c| {
+            let v = ViewTarget::new(&self.gpu, &mut self.egui.painter, samples);
+            c.texture_b = Some(v.id);
+            v
+        });
+        self.sim.update(&mut self.ui);
     }
 
     /// Step 3: the surface texture to draw into; `None` skips this frame (and schedules the

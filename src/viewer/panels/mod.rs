@@ -65,7 +65,7 @@ pub fn build(ui: &mut egui::Ui, state: &mut UiState, view_texture: egui::Texture
                 egui::CollapsingHeader::new(RichText::new("Solver").strong())
                     .default_open(true)
                     .show(ui, |ui| {
-                        compare_target::show(ui, state);
+                        compare_target::show(ui, state, &mut actions);
                         solver::show(ui, state);
                     });
                 egui::CollapsingHeader::new(RichText::new("Display").strong())
