@@ -131,13 +131,35 @@ pub(super) fn execute(args: &RenderArgs) -> Result<(), Failure> {
     let report = capture.finish().map_err(|e| capture_failure(&out, e))?;
     let wall = start.elapsed().as_secs_f64();
     write_summary(&out, &name, args, &report, &simulated, wall)?;
+    conclude(
+        args,
+        (&name, &out),
+        &report,
+        &simulated,
+        wall,
+        (solver.time, "frames", "simulation"),
+    )
+}
+
+/// The end of a render (plain or compared): an early stop reported with the frames that were
+/// written (up to `reached`, the simulated time), else the one-line summary unless `--quiet`.
+/// `frames` names the frames ("frames", "side-by-side frames"), `solver` the simulation time's
+/// label.
+pub(super) fn conclude(
+    args: &RenderArgs,
+    (name, out): (&str, &Path),
+    report: &CaptureReport,
+    simulated: &Simulated,
+    wall: f64,
+    (reached, frames, solver): (f64, &str, &str),
+) -> Result<(), Failure> {
     let reached = format!(
-        "{} frames up to t = {} s are in {}",
+        "{} {frames} up to t = {} s are in {}",
         report.frames,
-        short(solver.time),
+        short(reached),
         out.display()
     );
-    if let Some(e) = simulated.failure {
+    if let Some(e) = &simulated.failure {
         return Err(Failure::Diverged(format!(
             "{}: {e}; {reached}",
             args.scene.display()
@@ -151,7 +173,7 @@ pub(super) fn execute(args: &RenderArgs) -> Result<(), Failure> {
     }
     if !args.quiet {
         eprintln!(
-            "{name}: {} frames in {} s ({} frames/s; simulation {} s, render+readback {} ms/frame, PNG {} ms/frame on {}); frames in {}",
+            "{name}: {} {frames} in {} s ({} frames/s; {solver} {} s, render+readback {} ms/frame, PNG {} ms/frame on {}); frames in {}",
             report.frames,
             short(wall),
             short(report.frames as f64 / wall),

@@ -9,13 +9,14 @@ use std::time::Instant;
 
 use super::Progress;
 use super::exit::{self, Failure};
-use super::render::{RenderArgs, Simulated, capture_failure, capture_options, write_summary};
+use super::render::{
+    RenderArgs, Simulated, capture_failure, capture_options, conclude, write_summary,
+};
 use crate::compare::{CompareSpec, caption, labels};
 use crate::output::slug;
 use crate::render::{FrameCapture, RenderError};
 use crate::scene::Scene;
 use crate::solver::Solver;
-use crate::text::short;
 
 /// `render --compare`: as `render`, with two runs in each frame.
 pub(super) fn execute(args: &RenderArgs, scene: Scene, spec: &CompareSpec) -> Result<(), Failure> {
@@ -43,38 +44,18 @@ pub(super) fn execute(args: &RenderArgs, scene: Scene, spec: &CompareSpec) -> Re
     let report = capture.finish().map_err(|e| capture_failure(&out, e))?;
     let wall = start.elapsed().as_secs_f64();
     write_summary(&out, &name, args, &report, &simulated, wall)?;
-    let reached = format!(
-        "{} side-by-side frames up to t = {} s are in {}",
-        report.frames,
-        short(a.time.min(b.time)),
-        out.display()
-    );
-    if let Some(e) = simulated.failure {
-        return Err(Failure::Diverged(format!(
-            "{}: {e}; {reached}",
-            args.scene.display()
-        )));
-    }
-    if let Some(signal) = simulated.interrupted {
-        return Err(Failure::Interrupted(
-            signal,
-            format!("{}; {reached}", signal.name()),
-        ));
-    }
-    if !args.quiet {
-        eprintln!(
-            "{name}: {} side-by-side frames in {} s ({} frames/s; simulation of A and B {} s, render+readback {} ms/frame, PNG {} ms/frame on {}); frames in {}",
-            report.frames,
-            short(wall),
-            short(report.frames as f64 / wall),
-            short(simulated.seconds),
-            short(report.render_ms_per_frame()),
-            short(report.encode_ms_per_frame()),
-            report.adapter,
-            out.display()
-        );
-    }
-    Ok(())
+    conclude(
+        args,
+        (&name, &out),
+        &report,
+        &simulated,
+        wall,
+        (
+            a.time.min(b.time),
+            "side-by-side frames",
+            "simulation of A and B",
+        ),
+    )
 }
 
 /// Steps both solvers to each frame time in turn and submits the pair there, frame 0

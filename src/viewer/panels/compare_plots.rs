@@ -6,7 +6,7 @@
 use egui::Color32;
 use egui_plot::{Line, LineStyle, PlotPoints};
 
-use super::plots::{plot_title, series, small_plot};
+use super::plots::{plot_title, series, small_plot, thinned};
 use super::widgets::ACCENT;
 use crate::viewer::sim::StepRecord;
 use crate::viewer::state::UiState;
@@ -120,18 +120,7 @@ fn difference(
     h: f32,
 ) {
     plot_title(ui, title, tip);
-    let per = points.len().div_ceil(super::plots::PLOT_POINTS).max(1);
-    let pts: Vec<[f64; 2]> = points
-        .chunks(per)
-        .filter_map(|c| {
-            let v = c
-                .iter()
-                .map(&value)
-                .filter(|v| v.is_finite())
-                .reduce(f64::max)?;
-            Some([c[c.len() - 1][0], v])
-        })
-        .collect();
+    let pts = thinned(points, |p| p[0], value, f64::max);
     small_plot(id, h).show(ui, |p| {
         p.line(
             Line::new("A − B", PlotPoints::from(pts))

@@ -42,12 +42,23 @@ pub(super) fn series(
     value: impl Fn(&StepRecord) -> f64,
     reduce: fn(f64, f64) -> f64,
 ) -> Vec<[f64; 2]> {
-    let n = records.len();
+    thinned(records, |r| r.time, value, reduce)
+}
+
+/// At most [`PLOT_POINTS`] points of `items` in order: each point stands for a run of
+/// consecutive items, at the last one's time, with their finite values reduced by `reduce`.
+pub(super) fn thinned<T>(
+    items: &[T],
+    time: impl Fn(&T) -> f64,
+    value: impl Fn(&T) -> f64,
+    reduce: fn(f64, f64) -> f64,
+) -> Vec<[f64; 2]> {
+    let n = items.len();
     if n == 0 {
         return Vec::new();
     }
     let per = n.div_ceil(PLOT_POINTS).max(1);
-    records
+    items
         .chunks(per)
         .filter_map(|c| {
             let v = c
@@ -55,7 +66,7 @@ pub(super) fn series(
                 .map(&value)
                 .filter(|v| v.is_finite())
                 .reduce(reduce)?;
-            Some([c[c.len() - 1].time, v])
+            Some([time(&c[c.len() - 1]), v])
         })
         .collect()
 }
