@@ -2,7 +2,7 @@
 //! movable blocks as filled faces and outlines, projected with the shared camera and drawn by
 //! egui over A's picture, so where the two runs part is seen in place.
 
-use egui::{Color32, Pos2, Rect, Shape, Stroke, Vec2};
+use egui::{Color32, Pos2, Rect, Shape, Stroke};
 
 use crate::snapshot::Snapshot;
 use crate::viewer::state::UiState;
@@ -17,13 +17,7 @@ const GHOST_EDGE: Color32 = Color32::from_rgba_premultiplied(0x2F, 0x5F, 0xB0, 0
 
 /// Draws B's snapshot over `rect` (A's pane), seen by the shared camera.
 pub fn paint(painter: &egui::Painter, state: &UiState, b: &Snapshot, rect: Rect) {
-    let (w, h) = (rect.width(), rect.height());
-    let to_screen = |p: [f64; 3]| {
-        state
-            .view
-            .project(p, w, h)
-            .map(|(x, y)| rect.min + Vec2::new(x, y))
-    };
+    let to_screen = super::view_3d::projector(state, rect);
     for block in b.blocks.iter().filter(|b| !b.fixed).take(GHOST_BLOCKS) {
         let pts: Vec<Option<Pos2>> = block.vertices.iter().map(|v| to_screen(*v)).collect();
         for face in &block.faces {

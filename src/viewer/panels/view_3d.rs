@@ -44,19 +44,7 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState, texture: egui::TextureId) {
         return;
     };
     let snap = &frame.snapshot;
-    let (w, h) = (rect.width(), rect.height());
-    let to_screen = |p: [f64; 3]| {
-        state
-            .view
-            .project(p, w, h)
-            .map(|(x, y)| rect.min + Vec2::new(x, y))
-    };
-    if let Some(b) = state.selected.and_then(|i| snap.blocks.get(i)) {
-        outline(&painter, b, &to_screen);
-    }
-    if state.display.labels {
-        block_labels(&painter, rect, snap, state.selected, &to_screen);
-    }
+    annotate(&painter, state, snap, rect);
 
     if let Some(b) = state.compare.as_deref().filter(|c| c.ghost)
         && let Some(fb) = &b.frame_b
@@ -87,6 +75,11 @@ fn pane_b(ui: &egui::Ui, state: &mut UiState, rect: Rect) {
         return;
     };
     c.view_rect_b = rect;
+    // The rest only reads.
+    let state: &UiState = state;
+    let Some(c) = state.compare.as_deref() else {
+        return;
+    };
     let painter = ui.painter_at(rect);
     if let Some(t) = c.texture_b {
         let uv = Rect::from_min_max(Pos2::ZERO, Pos2::new(1.0, 1.0));
@@ -97,20 +90,7 @@ fn pane_b(ui: &egui::Ui, state: &mut UiState, rect: Rect) {
     let Some(frame) = c.frame_b.clone() else {
         return;
     };
-    let snap = &frame.snapshot;
-    let (w, h) = (rect.width(), rect.height());
-    let to_screen = |p: [f64; 3]| {
-        state
-            .view
-            .project(p, w, h)
-            .map(|(x, y)| rect.min + Vec2::new(x, y))
-    };
-    if let Some(b) = state.selected.and_then(|i| snap.blocks.get(i)) {
-        outline(&painter, b, &to_screen);
-    }
-    if state.display.labels {
-        block_labels(&painter, rect, snap, state.selected, &to_screen);
-    }
+    annotate(&painter, state, &frame.snapshot, rect);
     if let Some(scene) = &c.scene_b
         && scene.overlay
     {
@@ -160,6 +140,28 @@ fn camera_input(
 
 /// The selected block's outline, on top of everything (drawn through other blocks on purpose, so
 /// a block hidden behind others can still be followed).
+/// The shared camera's projection of a world point into `rect` (None behind the camera).
+pub(super) fn projector(state: &UiState, rect: Rect) -> impl Fn([f64; 3]) -> Option<Pos2> + '_ {
+    let (w, h) = (rect.width(), rect.height());
+    move |p| {
+        state
+            .view
+            .project(p, w, h)
+            .map(|(x, y)| rect.min + Vec2::new(x, y))
+    }
+}
+
+/// The selected block's outline and, when asked for, the block labels of `snap` in `rect`.
+fn annotate(painter: &egui::Painter, state: &UiState, snap: &Snapshot, rect: Rect) {
+    let to_screen = projector(state, rect);
+    if let Some(b) = state.selected.and_then(|i| snap.blocks.get(i)) {
+        outline(painter, b, &to_screen);
+    }
+    if state.display.labels {
+        block_labels(painter, rect, snap, state.selected, &to_screen);
+    }
+}
+
 fn outline(
     painter: &egui::Painter,
     b: &BlockSnapshot,
