@@ -74,6 +74,16 @@ pub fn best_of(scene: &Scene, repeat: usize, output: bool) -> Result<BenchRun, S
     Ok(best.expect("at least one run"))
 }
 
+/// The generated wall of `n` blocks in columns of 5 (`dda3d generate column`), with or without
+/// the rock, run for `duration` s.
+fn generated_wall(n: usize, rock: bool, duration: f64) -> Result<Scene, String> {
+    let text = crate::generate::column_wall(n, 5, rock);
+    let mut s = scene::parse(&text, &format!("generated wall of {n}"), "wall")
+        .map_err(|e| e.to_string())?;
+    s.params.duration = duration;
+    Ok(s)
+}
+
 /// Least-squares slope of log y against log x.
 pub fn growth_exponent(x: &[f64], y: &[f64]) -> f64 {
     let n = x.len() as f64;

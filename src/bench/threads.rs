@@ -4,9 +4,7 @@
 //! factorization and the solves do not (faer's parallel factorization was slower on these
 //! matrices), so the speed-up is that of the parallel share.
 
-use super::{BenchRun, best_of};
-use crate::generate::column_wall;
-use crate::scene;
+use super::{BenchRun, best_of, generated_wall};
 
 /// Prints the speed-up table for walls of `sizes` blocks, standing and struck.
 pub fn thread_table(sizes: &[usize], duration: f64) -> Result<(), String> {
@@ -24,10 +22,7 @@ pub fn thread_table(sizes: &[usize], duration: f64) -> Result<(), String> {
         .map_err(|e| format!("cannot make a one-thread pool: {e}"))?;
     for &n in sizes {
         for rock in [false, true] {
-            let text = column_wall(n, 5, rock);
-            let mut s = scene::parse(&text, &format!("generated wall of {n}"), "wall")
-                .map_err(|e| e.to_string())?;
-            s.params.duration = duration;
+            let s = generated_wall(n, rock, duration)?;
             let run = || best_of(&s, 1, false).map_err(|e| format!("wall of {n}: {e}"));
             let single = one.install(run)?;
             let pooled = run()?;

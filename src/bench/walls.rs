@@ -2,9 +2,7 @@
 //! counts, the wall time per simulated second, its split by stage, the cost of writing the
 //! output (apart), the peak memory and the growth exponents.
 
-use super::{best_of, growth_exponent};
-use crate::generate::column_wall;
-use crate::scene;
+use super::{best_of, generated_wall, growth_exponent};
 
 /// One scaling table on generated walls, with or without the rockfall.
 pub(super) fn scaling_table(
@@ -33,10 +31,7 @@ pub(super) fn scaling_table(
     let (mut ns, mut per_sim_s, mut walls, mut cs, mut cf) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for &n in sizes {
-        let text = column_wall(n, 5, rock);
-        let mut s = scene::parse(&text, &format!("generated wall of {n}"), "wall")
-            .map_err(|e| e.to_string())?;
-        s.params.duration = duration;
+        let s = generated_wall(n, rock, duration)?;
         let r = best_of(&s, if n >= 1000 { 1 } else { repeat }, true)
             .map_err(|e| format!("wall of {n}: {e}"))?;
         let t = &r.totals;
