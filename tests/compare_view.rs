@@ -11,7 +11,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use dda3d::render::gpu_required_by_env;
+mod window_support;
+
+use window_support::{have_xvfb_run, skip_or_fail};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_dda3d"))
@@ -28,24 +30,6 @@ fn tmp(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-/// Skips (returns false with a note) or fails, as the GPU policy says.
-fn skip_or_fail(why: &str) -> bool {
-    if gpu_required_by_env() {
-        panic!("{why} (DDA3D_REQUIRE_GPU is set, so the compare test may not be skipped)");
-    }
-    eprintln!("note: compare view test skipped: {why}");
-    false
-}
-
-fn have_xvfb_run() -> bool {
-    Command::new("sh")
-        .args(["-c", "command -v xvfb-run"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
 }
 
 /// Fraction of pixels in the rectangle that differ clearly from its first pixel.
@@ -108,7 +92,10 @@ fn finish(mut child: std::process::Child) -> (std::process::ExitStatus, String) 
 #[test]
 fn compare_window_shows_two_different_panes_after_the_impact() {
     if !have_xvfb_run() {
-        skip_or_fail("xvfb-run is not installed (Debian: apt-get install xvfb xauth)");
+        skip_or_fail(
+            "compare view",
+            "xvfb-run is not installed (Debian: apt-get install xvfb xauth)",
+        );
         return;
     }
     let dir = tmp("view");
@@ -141,7 +128,10 @@ fn compare_window_shows_two_different_panes_after_the_impact() {
     let (status, stderr) = finish(child);
     if !status.success() {
         if stderr.contains("no GPU adapter") {
-            skip_or_fail("no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)");
+            skip_or_fail(
+                "compare view",
+                "no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)",
+            );
             return;
         }
         panic!("viewer failed ({status}):\n{stderr}");
@@ -233,7 +223,10 @@ fn compare_render_writes_side_by_side_frames_that_differ_after_the_impact() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     if !out.status.success() {
         if stderr.contains("no GPU adapter") {
-            skip_or_fail("no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)");
+            skip_or_fail(
+                "compare view",
+                "no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)",
+            );
             return;
         }
         panic!("render --compare failed ({}):\n{stderr}", out.status);

@@ -9,7 +9,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use dda3d::render::gpu_required_by_env;
+mod window_support;
+
+use window_support::{have_xvfb_run, skip_or_fail};
 
 const WIDTH: u32 = 1280;
 const HEIGHT: u32 = 720;
@@ -29,24 +31,6 @@ fn tmp(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
-}
-
-/// Skips (returns false with a note) or fails, as the GPU policy says.
-fn skip_or_fail(why: &str) -> bool {
-    if gpu_required_by_env() {
-        panic!("{why} (DDA3D_REQUIRE_GPU is set, so the viewer test may not be skipped)");
-    }
-    eprintln!("note: viewer window test skipped: {why}");
-    false
-}
-
-fn have_xvfb_run() -> bool {
-    Command::new("sh")
-        .args(["-c", "command -v xvfb-run"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .status()
-        .is_ok_and(|s| s.success())
 }
 
 /// Fraction of pixels in the rectangle that differ clearly from its first pixel.
@@ -81,7 +65,10 @@ fn contains_color(img: &image::RgbImage, rect: [u32; 4], rgb: [u8; 3], tol: i32)
 #[test]
 fn window_screenshot_under_xvfb() {
     if !have_xvfb_run() {
-        skip_or_fail("xvfb-run is not installed (Debian: apt-get install xvfb xauth)");
+        skip_or_fail(
+            "viewer window",
+            "xvfb-run is not installed (Debian: apt-get install xvfb xauth)",
+        );
         return;
     }
     let dir = tmp("shot");
@@ -120,7 +107,10 @@ fn window_screenshot_under_xvfb() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     if !status.success() {
         if stderr.contains("no GPU adapter") {
-            skip_or_fail("no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)");
+            skip_or_fail(
+                "viewer window",
+                "no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)",
+            );
             return;
         }
         panic!("viewer failed ({status}):\n{stderr}");
