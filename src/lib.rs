@@ -18,7 +18,8 @@
 //! ```
 //!
 //! [`params`] holds every tunable; [`cli`] is the binary's front end, [`generate`] and [`bench`]
-//! its scene generator and benchmark.
+//! its scene generator and benchmark, [`study`] its parameter studies (a scene run many times
+//! with keys varied: scene → solver → a table of outcomes).
 
 pub mod bench;
 pub mod cli;
@@ -34,5 +35,6 @@ pub mod rockmass;
 pub mod scene;
 pub mod snapshot;
 pub mod solver;
+pub mod study;
 pub mod text;
 pub mod viewer;

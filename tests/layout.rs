@@ -196,6 +196,18 @@ const FORBIDDEN: &[(&str, &[&str], &[&str])] = &[
     ),
     // The viewer is driven by the command line, never the other way round.
     ("src/viewer/", &["crate::cli"], &[]),
+    // A parameter study drives runs as `run` does (scene → solver → outcomes) and writes its
+    // tables with output's helpers; the command line drives it, and its plots are its own.
+    (
+        "src/study/",
+        &[
+            "crate::render",
+            "crate::viewer",
+            "crate::cli",
+            "crate::compare",
+        ],
+        &["crate::contact", "crate::model", "crate::physics"],
+    ),
 ];
 
 #[test]

@@ -4,8 +4,8 @@
 //!
 //! One file per subcommand, each with its clap arguments and its entry function:
 //! [`run`](run()) (headless simulation), [`render`](render()) (PNG frames), [`generate`](generate())
-//! (scene files), [`cut`](cut()) (rock masses to blocks), [`bench`](bench()) and [`view`](view())
-//! (the interactive viewer). The command
+//! (scene files), [`cut`](cut()) (rock masses to blocks), [`study`](study()) (parameter studies),
+//! [`bench`](bench()) and [`view`](view()) (the interactive viewer). The command
 //! line is a contract: flags, defaults, help texts and exit statuses stay as they are.
 
 mod bench;
@@ -17,6 +17,7 @@ mod render;
 mod render_compare;
 mod resume;
 mod run;
+mod study;
 mod view;
 
 use std::ffi::OsString;
@@ -35,6 +36,7 @@ pub use cut::{CutArgs, cut};
 pub use generate::{GenerateArgs, GeneratedKind, generate};
 pub use render::{RenderArgs, render};
 pub use run::{Progress, RunArgs, run};
+pub use study::{StudyArgs, study};
 pub use view::{ViewArgs, view};
 
 #[derive(Parser, Debug)]
@@ -61,6 +63,9 @@ pub enum CliCommand {
     Cut(CutArgs),
     /// Time the rockfall scene with both methods, and the scaling on generated walls.
     Bench(BenchArgs),
+    /// Run a parameter study: a scene's keys varied over a grid or at random, the cases in
+    /// parallel; write study.csv, study.json and plots of each outcome against each key.
+    Study(StudyArgs),
     /// Open the interactive viewer (`dda3d SCENE.toml` is short for `dda3d view SCENE.toml`).
     View(ViewArgs),
 }
@@ -185,6 +190,7 @@ pub fn dispatch(cli: &Cli) -> Result<(), CliError> {
         CliCommand::Generate(args) => generate(args),
         CliCommand::Cut(args) => cut(args),
         CliCommand::Bench(args) => bench(args),
+        CliCommand::Study(args) => study(args),
         CliCommand::View(args) => view(args),
     }
 }
@@ -201,6 +207,7 @@ pub fn main_entry() -> ExitCode {
     let result = match &cli.command {
         CliCommand::Run(args) => run::execute(args),
         CliCommand::Render(args) => render::execute(args),
+        CliCommand::Study(args) => study::execute(args),
         CliCommand::Generate(_) | CliCommand::Cut(_) => {
             dispatch(&cli).map_err(|e| exit::Failure::from_cli(e, exit::Failure::Io))
         }
