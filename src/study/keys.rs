@@ -179,7 +179,7 @@ fn set_value(table: &mut dyn TableLike, seg: &Segment, f: &mut Visit<'_>) -> Res
             .ok_or_else(|| format!("{path}[{i}]: index out of range ({len} values)"))?;
         path = format!("{path}[{i}]");
     }
-    let mut new = f(Some(slot))?;
+    let mut new = f(Some(&*slot))?;
     *new.decor_mut() = slot.decor().clone();
     *slot = new;
     Ok(())

@@ -10,6 +10,7 @@
 //! moved_threshold = 0.1     # m, for blocks_moved
 //! toppled_angle = 30.0      # degrees, for blocks_toppled
 //! case_timeout = 600.0      # wall seconds a case may take (default: no limit)
+//! set = { "solver.duration" = 4.0 }               # keys given one value in every case
 //! [[parameters]]
 //! key = "joint.friction_angle"
 //! values = [25.0, 30.0, 35.0]                     # a grid axis
@@ -136,6 +137,8 @@ pub struct Study {
     scene_written: String,
     scene_text: String,
     scene_default_name: String,
+    /// The `set` table: keys given one value in every case.
+    fixed: Vec<(String, toml::Value)>,
     seed: u64,
     /// Random draws per grid point (1 without random parameters).
     draws: usize,
@@ -273,12 +276,13 @@ impl Study {
             )));
         }
         let values = self.values(case);
-        let overrides: Vec<(String, toml::Value)> = self
-            .parameters
-            .iter()
-            .zip(&values)
-            .map(|(p, (v, _))| (p.key.clone(), v.clone()))
-            .collect();
+        let mut overrides = self.fixed.clone();
+        overrides.extend(
+            self.parameters
+                .iter()
+                .zip(&values)
+                .map(|(p, (v, _))| (p.key.clone(), v.clone())),
+        );
         let scene_text = override_scene_text(&self.scene_text, &overrides).map_err(|e| {
             StudyError::input(format!("{}: case {case}: {e}", self.path.display()))
         })?;

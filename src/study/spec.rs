@@ -24,6 +24,9 @@ struct StudyFile {
     toppled_angle: Option<f64>,
     watch: Option<Vec<String>>,
     case_timeout: Option<f64>,
+    /// Keys set to one value in every case (not columns of the table).
+    #[serde(default)]
+    set: toml::Table,
 }
 
 #[derive(Deserialize)]
@@ -126,11 +129,21 @@ pub(super) fn load(path: &Path) -> Result<Study, StudyError> {
     if file.parameters.is_empty() {
         return Err(fail("no [[parameters]]: a study varies at least one scene key".into()));
     }
+    let fixed: Vec<(String, toml::Value)> = file.set.clone().into_iter().collect();
+    for (key, value) in &fixed {
+        let text = override_scene_text(&scene_text, &[(key.clone(), value.clone())])
+            .map_err(|e| fail(format!("set: {e} in {}", file.scene)))?;
+        crate::scene::parse(&text, &file.scene, &default_name)
+            .map_err(|e| fail(format!("set: key \"{key}\": {e}")))?;
+    }
     let mut parameters: Vec<Parameter> = Vec::new();
     for (i, p) in file.parameters.iter().enumerate() {
         let at = |m: String| fail(format!("parameters[{i}]: key \"{}\": {m}", p.key));
         if parameters.iter().any(|q| q.key == p.key) {
             return Err(at("given twice".into()));
+        }
+        if fixed.iter().any(|(k, _)| *k == p.key) {
+            return Err(at("also in set: a key is either set or varied".into()));
         }
         let dist = p.distribution().map_err(at)?;
         let param = check_key(p, dist, &scene_text, &file.scene, &default_name)
@@ -163,6 +176,7 @@ pub(super) fn load(path: &Path) -> Result<Study, StudyError> {
     Ok(Study {
         path: path.to_path_buf(),
         scene_written: file.scene.clone(),
+        fixed,
         fingerprint: fingerprint(&[&text, &scene_text]),
         scene_text,
         scene_default_name: default_name,

@@ -221,6 +221,7 @@ fn summary(study: &Study, records: &[&CaseRecord]) -> Value {
         "toppled_angle": study.settings.toppled_angle,
         "watch": study.settings.watch,
         "case_timeout": study.case_timeout,
+        "set": study.fixed.iter().cloned().collect::<toml::Table>(),
         "fingerprint": study.fingerprint,
         "finished": records.len(),
         "ok": ok,
