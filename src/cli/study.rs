@@ -86,7 +86,13 @@ pub(super) fn execute(args: &StudyArgs) -> Result<(), Failure> {
     bar.finish_and_clear();
     run?;
     study.assemble(&out, &records).map_err(failure)?;
-    conclude(&study, &out, &records, start.elapsed().as_secs_f64(), args.quiet)
+    conclude(
+        &study,
+        &out,
+        &records,
+        start.elapsed().as_secs_f64(),
+        args.quiet,
+    )
 }
 
 fn cores() -> usize {
@@ -101,8 +107,10 @@ fn progress(study: &Study, done: usize, quiet: bool) -> ProgressBar {
     };
     let bar = ProgressBar::with_draw_target(Some(study.len() as u64), target);
     bar.set_style(
-        ProgressStyle::with_template("[{elapsed_precise}] {bar:40} {pos}/{len} cases{msg} (eta {eta})")
-            .expect("valid template"),
+        ProgressStyle::with_template(
+            "[{elapsed_precise}] {bar:40} {pos}/{len} cases{msg} (eta {eta})",
+        )
+        .expect("valid template"),
     );
     bar.set_position(done as u64);
     bar
@@ -139,9 +147,9 @@ fn run_cases(
                         (Ok(task), Err(_)) => run_task_until(&task, &stop),
                         (Err(e), _) => Some(failed_task(study, case, &e)),
                     };
-                    match record {
-                        Some(r) if send.send(r).is_ok() => {}
-                        _ => break,
+                    // None: stopped by a signal. A closed channel: the main thread gave up.
+                    if record.is_none_or(|r| send.send(r).is_err()) {
+                        break;
                     }
                 }
             });
@@ -212,7 +220,11 @@ fn conclude(
     if let Some(signal) = exit::interrupted() {
         return Err(Failure::Interrupted(
             signal,
-            format!("{} of {} cases finished; {line}", records.len(), study.len()),
+            format!(
+                "{} of {} cases finished; {line}",
+                records.len(),
+                study.len()
+            ),
         ));
     }
     if !quiet {

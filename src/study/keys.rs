@@ -24,7 +24,9 @@ fn segments(key: &str) -> Result<Vec<Segment>, String> {
     for part in key.split('.') {
         let (name, mut rest) = part.split_at(part.find('[').unwrap_or(part.len()));
         if name.is_empty() {
-            return Err(bad("an empty part (a key is a dotted path such as solver.duration)"));
+            return Err(bad(
+                "an empty part (a key is a dotted path such as solver.duration)",
+            ));
         }
         let mut indexes = Vec::new();
         while !rest.is_empty() {
@@ -274,7 +276,10 @@ velocity = [-10.0, 0.0, 0.0]   # toward the column
     #[test]
     fn values_are_set_and_comments_kept() {
         let t = set("blocks.rock.velocity[0]", toml::Value::Float(-6.5)).unwrap();
-        assert!(t.contains("velocity = [-6.5, 0.0, 0.0]   # toward the column"), "{t}");
+        assert!(
+            t.contains("velocity = [-6.5, 0.0, 0.0]   # toward the column"),
+            "{t}"
+        );
         assert!(t.contains("# a comment kept"));
         let t = set("solver.duration", toml::Value::Float(0.5)).unwrap();
         assert!(t.contains("duration = 0.5  # s"), "{t}");
@@ -288,7 +293,10 @@ velocity = [-10.0, 0.0, 0.0]   # toward the column
     fn missing_tables_and_keys_are_created() {
         let t = set("solver.contact.initial_penalty", toml::Value::Float(2e9)).unwrap();
         let parsed: toml::Table = toml::from_str(&t).unwrap();
-        assert_eq!(parsed["solver"]["contact"]["initial_penalty"].as_float(), Some(2e9));
+        assert_eq!(
+            parsed["solver"]["contact"]["initial_penalty"].as_float(),
+            Some(2e9)
+        );
         assert_eq!(parsed["solver"]["duration"].as_float(), Some(2.0));
     }
 
@@ -297,7 +305,10 @@ velocity = [-10.0, 0.0, 0.0]   # toward the column
         let e = set("blocks.rok.velocity[0]", toml::Value::Float(1.0)).unwrap_err();
         assert_eq!(e, "key \"blocks.rok.velocity[0]\": no block named \"rok\"");
         let e = set("blocks.rock.velocity[3]", toml::Value::Float(1.0)).unwrap_err();
-        assert!(e.contains("velocity[3]: index out of range (3 values)"), "{e}");
+        assert!(
+            e.contains("velocity[3]: index out of range (3 values)"),
+            "{e}"
+        );
         let e = set("blocks.rock", toml::Value::Float(1.0)).unwrap_err();
         assert!(e.contains("names a whole block"), "{e}");
         let e = set("blocks.ground.angular_velocity[0]", toml::Value::Float(1.0)).unwrap_err();

@@ -283,9 +283,8 @@ impl Study {
                 .zip(&values)
                 .map(|(p, (v, _))| (p.key.clone(), v.clone())),
         );
-        let scene_text = override_scene_text(&self.scene_text, &overrides).map_err(|e| {
-            StudyError::input(format!("{}: case {case}: {e}", self.path.display()))
-        })?;
+        let scene_text = override_scene_text(&self.scene_text, &overrides)
+            .map_err(|e| StudyError::input(format!("{}: case {case}: {e}", self.path.display())))?;
         Ok(Task {
             case,
             keys: self.keys(),

@@ -13,6 +13,7 @@ pub enum Outcome {
     Runout,
     BlocksMoved,
     BlocksToppled,
+    BlocksRotated,
     PeakNormalForce,
     FinalKineticEnergy,
     MaxPenetration,
@@ -20,11 +21,12 @@ pub enum Outcome {
 }
 
 impl Outcome {
-    pub const ALL: [Outcome; 8] = [
+    pub const ALL: [Outcome; 9] = [
         Outcome::MaxDisplacement,
         Outcome::Runout,
         Outcome::BlocksMoved,
         Outcome::BlocksToppled,
+        Outcome::BlocksRotated,
         Outcome::PeakNormalForce,
         Outcome::FinalKineticEnergy,
         Outcome::MaxPenetration,
@@ -37,6 +39,7 @@ impl Outcome {
             Outcome::Runout => "runout",
             Outcome::BlocksMoved => "blocks_moved",
             Outcome::BlocksToppled => "blocks_toppled",
+            Outcome::BlocksRotated => "blocks_rotated",
             Outcome::PeakNormalForce => "peak_normal_force",
             Outcome::FinalKineticEnergy => "final_kinetic_energy",
             Outcome::MaxPenetration => "max_penetration",
@@ -47,7 +50,10 @@ impl Outcome {
     pub fn unit(self) -> &'static str {
         match self {
             Outcome::MaxDisplacement | Outcome::Runout | Outcome::MaxPenetration => "m",
-            Outcome::BlocksMoved | Outcome::BlocksToppled | Outcome::Steps => "",
+            Outcome::BlocksMoved
+            | Outcome::BlocksToppled
+            | Outcome::BlocksRotated
+            | Outcome::Steps => "",
             Outcome::PeakNormalForce => "N",
             Outcome::FinalKineticEnergy => "J",
         }
@@ -63,7 +69,8 @@ impl Outcome {
 pub struct OutcomeSettings {
     /// m: a block whose centroid ends farther than this from its start has moved.
     pub moved_threshold: f64,
-    /// Degrees: a block rotated more than this at the end has toppled.
+    /// Degrees: a block tilted more than this at the end has toppled (and one turned more than
+    /// this, about any axis, has rotated).
     pub toppled_angle: f64,
     /// Block names (a trailing `*` matches a prefix) the block outcomes consider; empty: every
     /// free block.
@@ -96,8 +103,7 @@ pub fn watched<'a>(
     blocks
         .enumerate()
         .filter(|(_, (name, fixed))| {
-            !fixed
-                && (settings.watch.is_empty() || settings.watch.iter().any(|p| matches(p, name)))
+            !fixed && (settings.watch.is_empty() || settings.watch.iter().any(|p| matches(p, name)))
         })
         .map(|(k, _)| k)
         .collect()
@@ -144,7 +150,10 @@ impl Tracker {
     }
 
     pub fn after_step(&mut self, solver: &Solver) {
-        let largest = self.displacements(solver).map(|d| d.norm()).fold(0.0, f64::max);
+        let largest = self
+            .displacements(solver)
+            .map(|d| d.norm())
+            .fold(0.0, f64::max);
         self.max_displacement = self.max_displacement.max(largest);
         let force = solver
             .contacts()
@@ -154,25 +163,45 @@ impl Tracker {
         self.peak_normal_force = self.peak_normal_force.max(force);
     }
 
-    /// The rotation of watched block `i` since the start, degrees: the angle of the best-fit
-    /// rotation (polar decomposition of the vertices' cross-covariance), which the blocks'
-    /// small strains do not disturb.
-    fn rotation_deg(&self, solver: &Solver, i: usize) -> f64 {
+    /// The rotation of watched block `i` since the start: the best-fit rotation of its
+    /// vertices (polar decomposition of their cross-covariance), which the blocks' small
+    /// strains do not disturb.
+    fn rotation(&self, solver: &Solver, i: usize) -> Option<Matrix3<f64>> {
         let b = &solver.model.blocks[self.watched[i]];
         let mut h = Matrix3::zeros();
         for (v, v0) in b.vertices.iter().zip(&self.start_shapes[i]) {
             h += (v - b.mp.centroid) * v0.transpose();
         }
         let svd = h.svd(true, true);
-        let (Some(u), Some(vt)) = (svd.u, svd.v_t) else {
-            return f64::NAN;
+        let (u, vt) = (svd.u?, svd.v_t?);
+        let r = u * vt;
+        Some(if r.determinant() < 0.0 {
+            u * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0)) * vt
+        } else {
+            r
+        })
+    }
+
+    /// The angle of that rotation, degrees.
+    fn rotation_deg(&self, solver: &Solver, i: usize) -> f64 {
+        self.rotation(solver, i).map_or(f64::NAN, |r| {
+            ((r.trace() - 1.0) / 2.0)
+                .clamp(-1.0, 1.0)
+                .acos()
+                .to_degrees()
+        })
+    }
+
+    /// How far the rotation tilts the block, degrees: the angle between the direction of
+    /// gravity and its image, so that a turn about the vertical (a block twisted in place by an
+    /// off-centre strike) is not a topple. Without gravity, the whole rotation.
+    fn tilt_deg(&self, solver: &Solver, i: usize) -> f64 {
+        let Some(down) = Vector3::from(solver.params.gravity).try_normalize(0.0) else {
+            return self.rotation_deg(solver, i);
         };
-        let mut r = u * vt;
-        if r.determinant() < 0.0 {
-            let flip = Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, -1.0));
-            r = u * flip * vt;
-        }
-        ((r.trace() - 1.0) / 2.0).clamp(-1.0, 1.0).acos().to_degrees()
+        self.rotation(solver, i).map_or(f64::NAN, |r| {
+            (r * down).dot(&down).clamp(-1.0, 1.0).acos().to_degrees()
+        })
     }
 
     /// The value of `outcome` at the end of the case.
@@ -194,6 +223,9 @@ impl Tracker {
                 .filter(|d| d.norm() > settings.moved_threshold)
                 .count() as f64,
             Outcome::BlocksToppled => (0..self.watched.len())
+                .filter(|&i| self.tilt_deg(solver, i) > settings.toppled_angle)
+                .count() as f64,
+            Outcome::BlocksRotated => (0..self.watched.len())
                 .filter(|&i| self.rotation_deg(solver, i) > settings.toppled_angle)
                 .count() as f64,
             Outcome::PeakNormalForce => self.peak_normal_force,
@@ -222,37 +254,74 @@ mod tests {
             watch: vec!["column*".into()],
             ..OutcomeSettings::default()
         };
-        let blocks = [("base", true), ("column2", false), ("rock", false), ("column3", false)];
+        let blocks = [
+            ("base", true),
+            ("column2", false),
+            ("rock", false),
+            ("column3", false),
+        ];
         assert_eq!(watched(&s, blocks.into_iter()), vec![1, 3]);
         let all = OutcomeSettings::default();
         assert_eq!(watched(&all, blocks.into_iter()), vec![1, 2, 3]);
     }
 
-    #[test]
-    fn a_block_turned_by_a_known_angle_measures_it() {
+    /// A free box, tracked from its start, then turned by `angle_deg` about `axis` and moved
+    /// by `shift`.
+    fn turned(axis: Vector3<f64>, angle_deg: f64, shift: Vector3<f64>) -> (Solver, Tracker) {
         let scene = crate::scene::parse(
             "[materials.r]\ndensity = 2000.0\nyoung_modulus = 1e9\npoisson_ratio = 0.2\n\
-             [[blocks]]\nname = \"b\"\nmaterial = \"r\"\nbox = { size = [1.0, 2.0, 3.0], center = [0.0, 0.0, 5.0] }\n",
+             [[blocks]]\nname = \"b\"\nmaterial = \"r\"\n\
+             box = { size = [1.0, 2.0, 3.0], center = [0.0, 0.0, 5.0] }\n",
             "t.toml",
             "t",
         )
         .unwrap();
         let mut solver = Solver::new(scene.model, scene.params);
-        let settings = OutcomeSettings::default();
-        let tracker = Tracker::start(&solver, &settings);
-        // Turn the block by 40° about a tilted axis and move it 3 m sideways, 4 m down.
-        let axis = nalgebra::Unit::new_normalize(Vector3::new(1.0, 2.0, 0.5));
-        let rot = nalgebra::Rotation3::from_axis_angle(&axis, 40f64.to_radians());
+        let tracker = Tracker::start(&solver, &OutcomeSettings::default());
+        let axis = nalgebra::Unit::new_normalize(axis);
+        let rot = nalgebra::Rotation3::from_axis_angle(&axis, angle_deg.to_radians());
         let b = &mut solver.model.blocks[0];
         let c = b.mp.centroid;
         for v in &mut b.vertices {
-            *v = c + rot * (*v - c) + Vector3::new(3.0, 0.0, -4.0);
+            *v = c + rot * (*v - c) + shift;
         }
         b.refresh();
+        (solver, tracker)
+    }
+
+    #[test]
+    fn a_block_turned_by_a_known_angle_measures_it() {
+        let settings = OutcomeSettings::default();
+        let axis = Vector3::new(1.0, 2.0, 0.5);
+        let (solver, tracker) = turned(axis, 40.0, Vector3::new(3.0, 0.0, -4.0));
         assert!((tracker.rotation_deg(&solver, 0) - 40.0).abs() < 1e-9);
+        // The tilt: the angle between z and its image, cos = cos θ + (1 − cos θ) n_z².
+        let nz2 = 0.25 / axis.norm_squared();
+        let c = 40f64.to_radians().cos();
+        let tilt = (c + (1.0 - c) * nz2).acos().to_degrees();
+        assert!((tracker.tilt_deg(&solver, 0) - tilt).abs() < 1e-9);
         let runout = tracker.value(Outcome::Runout, &solver, &settings);
         assert!((runout - 3.0).abs() < 1e-9, "{runout}");
-        assert_eq!(tracker.value(Outcome::BlocksToppled, &solver, &settings), 1.0);
+        assert_eq!(
+            tracker.value(Outcome::BlocksToppled, &solver, &settings),
+            1.0
+        );
+        assert_eq!(
+            tracker.value(Outcome::BlocksRotated, &solver, &settings),
+            1.0
+        );
         assert_eq!(tracker.value(Outcome::BlocksMoved, &solver, &settings), 1.0);
+        // Twisted about the vertical in place: rotated, not toppled, not moved.
+        let (solver, tracker) = turned(Vector3::z(), 60.0, Vector3::zeros());
+        assert!(tracker.tilt_deg(&solver, 0).abs() < 1e-6);
+        assert_eq!(
+            tracker.value(Outcome::BlocksToppled, &solver, &settings),
+            0.0
+        );
+        assert_eq!(
+            tracker.value(Outcome::BlocksRotated, &solver, &settings),
+            1.0
+        );
+        assert_eq!(tracker.value(Outcome::BlocksMoved, &solver, &settings), 0.0);
     }
 }

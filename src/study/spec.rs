@@ -55,7 +55,11 @@ impl ParameterSpec {
         if given.len() != 1 {
             return Err(format!(
                 "give exactly one of values, uniform, log_uniform, normal (got {})",
-                if given.is_empty() { "none".into() } else { given.join(" and ") }
+                if given.is_empty() {
+                    "none".into()
+                } else {
+                    given.join(" and ")
+                }
             ));
         }
         if self.bounds.is_some() && self.normal.is_none() {
@@ -122,12 +126,16 @@ pub(super) fn load(path: &Path) -> Result<Study, StudyError> {
     let settings = settings(&file, &base).map_err(fail)?;
     let case_timeout = match file.case_timeout {
         Some(t) if !(t.is_finite() && t > 0.0) => {
-            return Err(fail(format!("case_timeout = {t}: must be a positive number of seconds")));
+            return Err(fail(format!(
+                "case_timeout = {t}: must be a positive number of seconds"
+            )));
         }
         t => t,
     };
     if file.parameters.is_empty() {
-        return Err(fail("no [[parameters]]: a study varies at least one scene key".into()));
+        return Err(fail(
+            "no [[parameters]]: a study varies at least one scene key".into(),
+        ));
     }
     let fixed: Vec<(String, toml::Value)> = file.set.clone().into_iter().collect();
     for (key, value) in &fixed {
@@ -152,7 +160,9 @@ pub(super) fn load(path: &Path) -> Result<Study, StudyError> {
     }
     let dists: Vec<&Distribution> = parameters.iter().map(|p| &p.dist).collect();
     let grid = draw::grid_len(&dists, MAX_CASES).ok_or_else(|| {
-        fail(format!("the values lists make a grid of more than {MAX_CASES} cases"))
+        fail(format!(
+            "the values lists make a grid of more than {MAX_CASES} cases"
+        ))
     })?;
     let draws = if dists.iter().any(|d| d.is_random()) {
         let n = file.cases.ok_or_else(|| {
@@ -199,7 +209,10 @@ fn outcomes(names: &[String]) -> Result<Vec<Outcome>, String> {
     for n in names {
         let o = Outcome::from_name(n).ok_or_else(|| {
             let known: Vec<&str> = Outcome::ALL.iter().map(|o| o.name()).collect();
-            format!("outcomes: unknown outcome \"{n}\" (known: {})", known.join(", "))
+            format!(
+                "outcomes: unknown outcome \"{n}\" (known: {})",
+                known.join(", ")
+            )
         })?;
         if out.contains(&o) {
             return Err(format!("outcomes: \"{n}\" given twice"));
@@ -220,7 +233,9 @@ fn settings(file: &StudyFile, base: &crate::scene::Scene) -> Result<OutcomeSetti
     }
     if let Some(a) = file.toppled_angle {
         if !(a > 0.0 && a < 180.0) {
-            return Err(format!("toppled_angle = {a}: must be between 0 and 180 degrees"));
+            return Err(format!(
+                "toppled_angle = {a}: must be between 0 and 180 degrees"
+            ));
         }
         s.toppled_angle = a;
     }

@@ -136,15 +136,23 @@ fn plot_columns(study: &Study, records: &[&CaseRecord]) -> (Vec<PlotColumn>, Vec
             let raw: Vec<Option<&Value>> = records.iter().map(|r| r.values.get(k)).collect();
             let numeric = raw.iter().flatten().all(|v| v.is_number());
             let (values, categories) = if numeric {
-                (raw.iter().map(|v| v.and_then(Value::as_f64)).collect(), None)
+                (
+                    raw.iter().map(|v| v.and_then(Value::as_f64)).collect(),
+                    None,
+                )
             } else {
                 // Labels in the order of the values list.
                 let labels: Vec<String> = match &p.dist {
-                    Distribution::Values(v) => v.iter().map(|x| cell(&super::json_value(x))).collect(),
+                    Distribution::Values(v) => {
+                        v.iter().map(|x| cell(&super::json_value(x))).collect()
+                    }
                     _ => Vec::new(),
                 };
                 let index = |v: &Value| labels.iter().position(|l| *l == cell(v)).map(|i| i as f64);
-                (raw.iter().map(|v| v.and_then(index)).collect(), Some(labels))
+                (
+                    raw.iter().map(|v| v.and_then(index)).collect(),
+                    Some(labels),
+                )
             };
             PlotColumn {
                 name: p.key.clone(),
@@ -262,10 +270,12 @@ pub fn finished(study: &Study, out: &Path) -> Result<Vec<CaseRecord>, StudyError
             .map_err(|e| StudyError::io(format!("{}: cannot list: {e}", dir.display())))?
             .path();
         let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
-        let Some(case) = name
-            .as_deref()
-            .and_then(|n| n.strip_prefix("case_")?.strip_suffix(".json")?.parse::<usize>().ok())
-        else {
+        let Some(case) = name.as_deref().and_then(|n| {
+            n.strip_prefix("case_")?
+                .strip_suffix(".json")?
+                .parse::<usize>()
+                .ok()
+        }) else {
             continue;
         };
         let text = std::fs::read_to_string(&path)
@@ -273,7 +283,11 @@ pub fn finished(study: &Study, out: &Path) -> Result<Vec<CaseRecord>, StudyError
         let record = CaseRecord::from_json(&text)
             .map_err(|e| StudyError::input(format!("{}: {e}", path.display())))?;
         if record.fingerprint != study.fingerprint {
-            return Err(another_study(study, out, &format!("{} is a record", path.display())));
+            return Err(another_study(
+                study,
+                out,
+                &format!("{} is a record", path.display()),
+            ));
         }
         if record.case != case || case >= study.len {
             return Err(StudyError::input(format!(
