@@ -34,8 +34,9 @@
 //!   displacement of a watched free block over the run), `runout` (m, largest distance
 //!   perpendicular to gravity between a watched block's centroid at the end and at the start),
 //!   `blocks_moved` (watched blocks ending more than `moved_threshold` from their start),
-//!   `blocks_toppled` (watched blocks rotated more than `toppled_angle` at the end, by the
-//!   best-fit rotation of their vertices), `peak_normal_force` (N, largest contact normal
+//!   `blocks_toppled` (watched blocks tilted more than `toppled_angle` at the end: the angle
+//!   between gravity's direction and its image under the best-fit rotation of the block's
+//!   vertices), `blocks_rotated` (the same with the whole rotation angle), `peak_normal_force` (N, largest contact normal
 //!   force over the run), `final_kinetic_energy` (J), `max_penetration` (m, as summary.json),
 //!   `steps`. The start is t = 0, after any initial equilibrium stage.
 //! - **Running** ([`run_task`]): a case runs its scene to its duration; a scene error, a
