@@ -34,5 +34,6 @@ pub mod rockmass;
 pub mod scene;
 pub mod snapshot;
 pub mod solver;
+pub mod study;
 pub mod text;
 pub mod viewer;

@@ -196,6 +196,9 @@ const FORBIDDEN: &[(&str, &[&str], &[&str])] = &[
     ),
     // The viewer is driven by the command line, never the other way round.
     ("src/viewer/", &["crate::cli"], &[]),
+    // The study's plots draw columns of numbers: nothing of the runs, the files or the pictures
+    // of a run.
+    ("src/study/plots", FRONT, ENGINE),
 ];
 
 #[test]
