@@ -1,24 +1,24 @@
 //! PNG plots of a study's outcomes against its varied parameters: one scatter per (outcome,
 //! parameter) pair and an overview grid of them all.
 //!
-//! Drawn with plotters into an RGB buffer and encoded by `image`'s PNG encoder, with the font
-//! compiled in (egui's Ubuntu Light, through `epaint_default_fonts`): no system font library, so
-//! the plots look the same, byte for byte, on every machine.
+//! Drawn with plotters into an RGB buffer and encoded by `image`'s PNG encoder, the text set
+//! from a compiled-in font (see [`canvas`]): no system font library, so the plots look the same,
+//! byte for byte, on every machine.
 
 mod axis;
+mod canvas;
 mod panel;
 
 use std::collections::HashSet;
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
 
 use image::ImageEncoder;
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use plotters::prelude::*;
-use plotters::style::FontStyle;
 
 use axis::Axis;
+use canvas::Canvas;
 use panel::{Panel, Sizes};
 
 /// One column of the study table for plotting: a varied parameter or an outcome.
@@ -65,7 +65,6 @@ pub fn write_plots(
     outcomes: &[PlotColumn],
 ) -> Result<Vec<PathBuf>, String> {
     check_lengths(parameters, outcomes)?;
-    register_font()?;
     let plots = dir.join("plots");
     fs::create_dir_all(&plots).map_err(|e| format!("cannot create {}: {e}", plots.display()))?;
     let mut written = Vec::new();
@@ -96,24 +95,6 @@ fn check_lengths(parameters: &[PlotColumn], outcomes: &[PlotColumn]) -> Result<(
         }
     }
     Ok(())
-}
-
-/// Registers the compiled-in font under plotters' default family, once per process.
-fn register_font() -> Result<(), String> {
-    static REGISTERED: OnceLock<bool> = OnceLock::new();
-    let ok = *REGISTERED.get_or_init(|| {
-        plotters::style::register_font(
-            panel::FONT,
-            FontStyle::Normal,
-            epaint_default_fonts::UBUNTU_LIGHT,
-        )
-        .is_ok()
-    });
-    if ok {
-        Ok(())
-    } else {
-        Err("study plots: the compiled-in font cannot be read".into())
-    }
 }
 
 /// A file-name part from a column name: lower case, runs of other characters become '_', cut
@@ -281,14 +262,15 @@ fn overview(parameters: &[PlotColumn], outcomes: &[PlotColumn]) -> Result<Vec<u8
     }
     let scale = overview_scale(rows, cols);
     let sizes = Sizes::scaled(scale * 0.8);
-    let ticks = |pixels: u32| ((pixels as f64 * scale) / 70.0).floor().max(3.0) as usize;
+    // About one tick label per 70 px across and per 45 px up.
+    let ticks = |pixels: u32, per: f64| ((pixels as f64 * scale) / per).floor().max(3.0) as usize;
     let x_axes: Vec<Axis> = shown_parameters
         .iter()
-        .map(|p| axis_of(p, ticks(PANEL.0)))
+        .map(|p| axis_of(p, ticks(PANEL.0, 70.0)))
         .collect();
     let y_axes: Vec<Axis> = shown_outcomes
         .iter()
-        .map(|o| axis_of(o, ticks(PANEL.1)))
+        .map(|o| axis_of(o, ticks(PANEL.1, 45.0)))
         .collect();
     render(size, |root| {
         root.fill(&WHITE)
@@ -335,11 +317,11 @@ fn plural(n: usize, noun: &str) -> String {
 /// and filter, the same picture gives the same bytes.
 fn render(
     size: (u32, u32),
-    draw: impl FnOnce(&DrawingArea<BitMapBackend<'_>, plotters::coord::Shift>) -> Result<(), String>,
+    draw: impl FnOnce(&DrawingArea<Canvas<'_>, plotters::coord::Shift>) -> Result<(), String>,
 ) -> Result<Vec<u8>, String> {
     let mut rgb = vec![255u8; size.0 as usize * size.1 as usize * 3];
     {
-        let root = BitMapBackend::with_buffer(&mut rgb, size).into_drawing_area();
+        let root = Canvas::new(&mut rgb, size)?.into_drawing_area();
         draw(&root)?;
         root.present()
             .map_err(|e| format!("cannot draw a plot: {e}"))?;

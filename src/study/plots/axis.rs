@@ -67,7 +67,7 @@ impl Axis {
         }
         let integral = !finite.is_empty() && finite.iter().all(|v| v.fract() == 0.0);
         let (lo, hi) = linear_range(&finite, integral);
-        let step = tick_step(hi - lo, max_ticks, integral);
+        let step = tick_step(lo, hi, max_ticks, integral);
         Axis {
             lo,
             hi,
@@ -156,16 +156,19 @@ pub fn linear_range(values: &[f64], integral: bool) -> (f64, f64) {
     (min - MARGIN * span, max + MARGIN * span)
 }
 
-/// The step between ticks: 1, 2 or 5 times a power of ten, the smallest that gives at most
-/// `max_ticks` ticks over `span`; at least 1 for whole numbers.
-pub fn tick_step(span: f64, max_ticks: usize, integral: bool) -> f64 {
-    let raw = span / max_ticks.max(2) as f64;
-    let power = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0]
-        .into_iter()
-        .map(|m| m * power)
-        .find(|&s| s >= raw)
-        .unwrap_or(10.0 * power);
+/// The step between ticks over `lo..hi`: 1, 2 or 5 times a power of ten, the smallest that
+/// gives at most `max_ticks` ticks; at least 1 for whole numbers.
+pub fn tick_step(lo: f64, hi: f64, max_ticks: usize, integral: bool) -> f64 {
+    let count = |step: f64| ((hi / step).floor() - (lo / step).ceil() + 1.0).max(0.0) as usize;
+    // A step of span / max_ticks gives at most max_ticks + 1 ticks, so the answer is that or
+    // one of the next smaller nice steps.
+    let raw = (hi - lo) / max_ticks.max(1) as f64;
+    let decade = raw.log10().floor() as i32;
+    let steps = (decade - 1..=decade + 1).flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)));
+    let step = steps
+        .filter(|&s| count(s) <= max_ticks)
+        .reduce(f64::min)
+        .unwrap_or(raw);
     if integral { step.max(1.0) } else { step }
 }
 
@@ -208,7 +211,7 @@ pub fn log_ticks(lo: f64, hi: f64, max_ticks: usize) -> (Vec<f64>, Vec<f64>) {
     }
     // Less than a decade: ticks at round values, placed at their logarithms.
     let (a, b) = (10f64.powf(lo), 10f64.powf(hi));
-    let step = tick_step(b - a, max_ticks, false);
+    let step = tick_step(a, b, max_ticks, false);
     let ticks = multiples(a, b, step)
         .into_iter()
         .filter(|v| *v > 0.0)
@@ -287,11 +290,13 @@ mod tests {
 
     #[test]
     fn steps_are_one_two_five_and_whole_for_counts() {
-        assert_eq!(tick_step(10.0, 5, false), 2.0);
-        assert_eq!(tick_step(10.0, 10, false), 1.0);
-        assert_eq!(tick_step(3.0, 5, false), 1.0);
-        assert_eq!(tick_step(0.9, 4, false), 0.5);
-        assert_eq!(tick_step(0.4, 8, true), 1.0);
+        assert_eq!(tick_step(0.0, 10.0, 6, false), 2.0);
+        assert_eq!(tick_step(0.0, 10.0, 11, false), 1.0);
+        assert_eq!(tick_step(0.0, 10.0, 10, false), 2.0);
+        // 2, 4, 6, 8 fit in 4 ticks where span / 4 = 2.1 would ask for a step of 5.
+        assert_eq!(tick_step(1.5, 9.9, 4, false), 2.0);
+        assert_eq!(tick_step(0.05, 0.95, 4, false), 0.2);
+        assert_eq!(tick_step(0.0, 0.4, 8, true), 1.0);
         assert_eq!(multiples(-0.2, 4.2, 1.0), vec![0.0, 1.0, 2.0, 3.0, 4.0]);
         assert_eq!(multiples(0.05, 0.95, 0.5), vec![0.5]);
         assert_eq!(multiples(0.0, 1.0, f64::NAN), Vec::<f64>::new());

@@ -1,15 +1,18 @@
 //! One scatter panel drawn with plotters: a title, a subtitle, the axes of two [`Axis`] and the
 //! points; the single plots and each cell of the overview are such a panel at different sizes.
 
+use std::ops::Range;
+
 use plotters::coord::Shift;
-use plotters::coord::ranged1d::BindKeyPoints;
+use plotters::coord::ranged1d::{DefaultFormatting, KeyPointHint, Ranged};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::axis::{Axis, Scale};
+use super::canvas::Canvas;
 
-/// The family every text is drawn in: plotters' default, which the module registers from bytes
-/// (see [`super::register_font`]), so a style left at its default still finds the font.
+/// The family named in every text style; [`Canvas`] sets all text in its one font whatever the
+/// family, and this is plotters' default, so a style left at its default reads the same.
 pub const FONT: &str = "sans-serif";
 
 const POINT: RGBColor = RGBColor(31, 119, 180);
@@ -62,11 +65,7 @@ fn fail(e: impl std::fmt::Display) -> String {
 }
 
 /// The widest of `labels` in pixels, in `style`.
-fn widest(
-    area: &DrawingArea<BitMapBackend<'_>, Shift>,
-    labels: &[String],
-    style: &TextStyle,
-) -> u32 {
+fn widest(area: &DrawingArea<Canvas<'_>, Shift>, labels: &[String], style: &TextStyle) -> u32 {
     labels
         .iter()
         .filter_map(|l| area.estimate_text_size(l, style).ok())
@@ -75,9 +74,38 @@ fn widest(
         .unwrap_or(0)
 }
 
+/// An [`Axis`] as a plotters coordinate: linear in positions, with the axis' own ticks (the
+/// mesh's light lines at the minor ticks) and the label formatter given to the mesh.
+struct Coord<'a>(&'a Axis);
+
+impl Ranged for Coord<'_> {
+    type ValueType = f64;
+    type FormatOption = DefaultFormatting;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        let fraction = (value - self.0.lo) / (self.0.hi - self.0.lo);
+        let pixels = f64::from(limit.1 - limit.0) * fraction;
+        // Far outside the axis (never a drawn point, which the axis range holds) the pixel is
+        // clamped rather than wrapped.
+        limit.0 + pixels.round().clamp(-1e6, 1e6) as i32
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            self.0.minor.clone()
+        } else {
+            self.0.ticks.clone()
+        }
+    }
+
+    fn range(&self) -> Range<f64> {
+        self.0.lo..self.0.hi
+    }
+}
+
 /// Draws `panel` filling `area`.
 pub fn draw(
-    area: &DrawingArea<BitMapBackend<'_>, Shift>,
+    area: &DrawingArea<Canvas<'_>, Shift>,
     panel: &Panel,
     sizes: Sizes,
 ) -> Result<(), String> {
@@ -93,18 +121,12 @@ pub fn draw(
     // Room for the widest tick label, the gap to it and the rotated axis description.
     let y_area = widest(&area, &y_labels, &tick_style) + (sizes.text * 2.2) as u32;
     let x_area = (sizes.tick * 1.6 + sizes.text * 1.8) as u32;
-    let x_spec = (panel.x.lo..panel.x.hi)
-        .with_key_points(panel.x.ticks.clone())
-        .with_light_points(panel.x.minor.clone());
-    let y_spec = (panel.y.lo..panel.y.hi)
-        .with_key_points(panel.y.ticks.clone())
-        .with_light_points(panel.y.minor.clone());
     let mut chart = ChartBuilder::on(&area)
         .margin(sizes.margin)
         .margin_top(sizes.margin / 2)
         .x_label_area_size(x_area)
         .y_label_area_size(y_area)
-        .build_cartesian_2d(x_spec, y_spec)
+        .build_cartesian_2d(Coord(panel.x), Coord(panel.y))
         .map_err(fail)?;
     let x_label = |v: &f64| panel.x.label(*v);
     let y_label = |v: &f64| panel.y.label(*v);
