@@ -262,11 +262,11 @@ fn overview(parameters: &[PlotColumn], outcomes: &[PlotColumn]) -> Result<Vec<u8
     }
     let scale = overview_scale(rows, cols);
     let sizes = Sizes::scaled(scale * 0.8);
-    // About one tick label per 70 px across and per 45 px up.
+    // About one tick label per 55 px across and per 45 px up.
     let ticks = |pixels: u32, per: f64| ((pixels as f64 * scale) / per).floor().max(3.0) as usize;
     let x_axes: Vec<Axis> = shown_parameters
         .iter()
-        .map(|p| axis_of(p, ticks(PANEL.0, 70.0)))
+        .map(|p| axis_of(p, ticks(PANEL.0, 55.0)))
         .collect();
     let y_axes: Vec<Axis> = shown_outcomes
         .iter()

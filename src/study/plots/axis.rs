@@ -10,7 +10,7 @@ pub enum Scale {
     Linear { integral: bool },
     /// Positions are log10 of the values.
     Log10,
-    /// Positions are indexes into these labels.
+    /// Positions are indexes into these labels (cut to the room they have).
     Categories(Vec<String>),
 }
 
@@ -29,8 +29,11 @@ pub struct Axis {
 /// on the frame.
 const MARGIN: f64 = 0.05;
 
-/// A category label longer than this is cut, so that neighbouring labels do not run together.
-const MAX_CATEGORY_CHARS: usize = 14;
+/// About how many characters of a tick label fit in the room of one of `max_ticks` ticks; a
+/// category label is cut to the room its share of the ticks leaves, so that neighbouring labels
+/// do not run together, and never beyond [`MAX_CATEGORY_CHARS`].
+const CHARS_PER_TICK: usize = 12;
+const MAX_CATEGORY_CHARS: usize = 24;
 
 impl Axis {
     /// The axis for a column's `values`. `log`: draw it in log scale, which needs every value
@@ -109,10 +112,7 @@ impl Axis {
                 if index < 0.0 {
                     return String::new();
                 }
-                labels
-                    .get(index as usize)
-                    .map(|l| cut(l, MAX_CATEGORY_CHARS))
-                    .unwrap_or_default()
+                labels.get(index as usize).cloned().unwrap_or_default()
             }
         }
     }
@@ -123,12 +123,14 @@ impl Axis {
 fn categorical(labels: &[String], max_ticks: usize) -> Axis {
     let n = labels.len();
     let every = n.div_ceil(max_ticks).max(1);
+    let ticks: Vec<f64> = (0..n).step_by(every).map(|i| i as f64).collect();
+    let room = (CHARS_PER_TICK * max_ticks / ticks.len().max(1)).clamp(6, MAX_CATEGORY_CHARS);
     Axis {
         lo: -0.5,
         hi: n.max(1) as f64 - 0.5,
-        ticks: (0..n).step_by(every).map(|i| i as f64).collect(),
+        ticks,
         minor: Vec::new(),
-        scale: Scale::Categories(labels.to_vec()),
+        scale: Scale::Categories(labels.iter().map(|l| cut(l, room)).collect()),
     }
 }
 
@@ -164,11 +166,18 @@ pub fn tick_step(lo: f64, hi: f64, max_ticks: usize, integral: bool) -> f64 {
     // one of the next smaller nice steps.
     let raw = (hi - lo) / max_ticks.max(1) as f64;
     let decade = raw.log10().floor() as i32;
-    let steps = (decade - 1..=decade + 1).flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)));
-    let step = steps
-        .filter(|&s| count(s) <= max_ticks)
-        .reduce(f64::min)
-        .unwrap_or(raw);
+    let steps: Vec<f64> = (decade - 1..=decade + 1)
+        .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
+        .collect();
+    let smallest = |limit: usize| {
+        let fitting = steps.iter().copied().filter(|&s| count(s) <= limit);
+        fitting.reduce(f64::min).unwrap_or(raw)
+    };
+    let mut step = smallest(max_ticks);
+    // One or two ticks say little about a scale: one tick over the budget is the better deal.
+    if count(step) < 3 {
+        step = smallest(max_ticks + 1);
+    }
     if integral { step.max(1.0) } else { step }
 }
 
@@ -297,6 +306,8 @@ mod tests {
         assert_eq!(tick_step(1.5, 9.9, 4, false), 2.0);
         assert_eq!(tick_step(0.05, 0.95, 4, false), 0.2);
         assert_eq!(tick_step(0.0, 0.4, 8, true), 1.0);
+        // 6, 8, …, 14 is one tick over 4, but 5 would leave the single tick 10.
+        assert_eq!(tick_step(5.6, 14.4, 4, false), 2.0);
         assert_eq!(multiples(-0.2, 4.2, 1.0), vec![0.0, 1.0, 2.0, 3.0, 4.0]);
         assert_eq!(multiples(0.05, 0.95, 0.5), vec![0.5]);
         assert_eq!(multiples(0.0, 1.0, f64::NAN), Vec::<f64>::new());
@@ -362,12 +373,17 @@ mod tests {
 
     #[test]
     fn categories_sit_at_their_indexes() {
-        let labels = vec!["alm".to_string(), "penalty-with-a-long-name".to_string()];
+        let labels = vec![
+            "alm".to_string(),
+            "penalty-with-a-much-longer-name".to_string(),
+        ];
         let axis = Axis::new(&some(&[0.0, 1.0, 1.0]), false, Some(&labels), 6);
         assert_eq!((axis.lo, axis.hi), (-0.5, 1.5));
         assert_eq!(axis.ticks, vec![0.0, 1.0]);
         assert_eq!(axis.label(0.0), "alm");
-        assert_eq!(axis.label(1.0), "penalty-with-…");
+        assert_eq!(axis.label(1.0), "penalty-with-a-much-lon…");
+        let narrow = Axis::new(&[], false, Some(&labels), 2);
+        assert_eq!(narrow.label(1.0), "penalty-wit…");
         assert_eq!(axis.position(1.0), Some(1.0));
         assert_eq!(axis.position(2.0), None);
         assert_eq!(axis.position(0.5), None);

@@ -103,6 +103,24 @@ impl Ranged for Coord<'_> {
     }
 }
 
+/// `text` cut at its end, the cut marked with an ellipsis, to at most `room` pixels wide in
+/// `style`: long column names in the small panels of an overview.
+fn fit(area: &DrawingArea<Canvas<'_>, Shift>, text: &str, style: &TextStyle, room: u32) -> String {
+    let fits = |t: &str| {
+        area.estimate_text_size(t, style)
+            .is_ok_and(|(w, _)| w <= room)
+    };
+    if fits(text) {
+        return text.to_string();
+    }
+    let chars: Vec<char> = text.chars().collect();
+    (0..chars.len())
+        .rev()
+        .map(|n| chars[..n].iter().collect::<String>() + "…")
+        .find(|t| fits(t))
+        .unwrap_or_default()
+}
+
 /// Draws `panel` filling `area`.
 pub fn draw(
     area: &DrawingArea<Canvas<'_>, Shift>,
@@ -110,11 +128,14 @@ pub fn draw(
     sizes: Sizes,
 ) -> Result<(), String> {
     area.fill(&WHITE).map_err(fail)?;
-    let mut area = area.titled(&panel.title, font(sizes.title)).map_err(fail)?;
+    let (width, _) = area.dim_in_pixel();
+    let room = width.saturating_sub(2 * sizes.margin);
+    let title = fit(area, &panel.title, &font(sizes.title), room);
+    let mut area = area.titled(&title, font(sizes.title)).map_err(fail)?;
     if !panel.subtitle.is_empty() {
-        area = area
-            .titled(&panel.subtitle, font(sizes.text).color(&GREY_TEXT))
-            .map_err(fail)?;
+        let style = font(sizes.text).color(&GREY_TEXT);
+        let subtitle = fit(&area, &panel.subtitle, &style, room);
+        area = area.titled(&subtitle, style).map_err(fail)?;
     }
     let tick_style = font(sizes.tick);
     let y_labels: Vec<String> = panel.y.ticks.iter().map(|&t| panel.y.label(t)).collect();
@@ -128,12 +149,15 @@ pub fn draw(
         .y_label_area_size(y_area)
         .build_cartesian_2d(Coord(panel.x), Coord(panel.y))
         .map_err(fail)?;
+    let (plot_width, plot_height) = chart.plotting_area().dim_in_pixel();
+    let x_desc = fit(&area, &panel.x_desc, &font(sizes.text), plot_width);
+    let y_desc = fit(&area, &panel.y_desc, &font(sizes.text), plot_height);
     let x_label = |v: &f64| panel.x.label(*v);
     let y_label = |v: &f64| panel.y.label(*v);
     chart
         .configure_mesh()
-        .x_desc(panel.x_desc.as_str())
-        .y_desc(panel.y_desc.as_str())
+        .x_desc(x_desc)
+        .y_desc(y_desc)
         .x_label_formatter(&x_label)
         .y_label_formatter(&y_label)
         .label_style(tick_style.clone())
@@ -142,6 +166,13 @@ pub fn draw(
         .light_line_style(MINOR_GRID)
         .draw()
         .map_err(fail)?;
+    // The medians first, so that the points at the median stay visible on top of them.
+    if matches!(panel.x.scale, Scale::Categories(_)) {
+        let bars = medians(&panel.points).into_iter().map(|(x, m)| {
+            PathElement::new(vec![(x - 0.3, m), (x + 0.3, m)], MEDIAN.stroke_width(2))
+        });
+        chart.draw_series(bars).map_err(fail)?;
+    }
     let style = POINT.mix(0.6).filled();
     chart
         .draw_series(
@@ -151,12 +182,6 @@ pub fn draw(
                 .map(|&p| Circle::new(p, sizes.point, style)),
         )
         .map_err(fail)?;
-    if matches!(panel.x.scale, Scale::Categories(_)) {
-        let bars = medians(&panel.points).into_iter().map(|(x, m)| {
-            PathElement::new(vec![(x - 0.3, m), (x + 0.3, m)], MEDIAN.stroke_width(2))
-        });
-        chart.draw_series(bars).map_err(fail)?;
-    }
     if panel.points.is_empty() {
         let centre = (
             (panel.x.lo + panel.x.hi) / 2.0,
