@@ -144,8 +144,9 @@ pub fn linear_range(values: &[f64], integral: bool) -> (f64, f64) {
     let (min, max) = values
         .iter()
         .fold((first, first), |(lo, hi), &v| (lo.min(v), hi.max(v)));
-    let span = max - min;
-    if span <= max.abs().max(min.abs()) * 1e-12 {
+    // Halves throughout, so that values near ±f64::MAX give a finite span.
+    let half_span = max / 2.0 - min / 2.0;
+    if half_span <= max.abs().max(min.abs()) * 0.5e-12 {
         let mut half = max.abs() * 0.1;
         if integral {
             half = half.max(1.0);
@@ -155,7 +156,8 @@ pub fn linear_range(values: &[f64], integral: bool) -> (f64, f64) {
         }
         return (max - half, max + half);
     }
-    (min - MARGIN * span, max + MARGIN * span)
+    let margin = MARGIN * 2.0 * half_span;
+    ((min - margin).max(f64::MIN), (max + margin).min(f64::MAX))
 }
 
 /// The step between ticks over `lo..hi`: 1, 2 or 5 times a power of ten, the smallest that
@@ -164,7 +166,8 @@ pub fn tick_step(lo: f64, hi: f64, max_ticks: usize, integral: bool) -> f64 {
     let count = |step: f64| ((hi / step).floor() - (lo / step).ceil() + 1.0).max(0.0) as usize;
     // A step of span / max_ticks gives at most max_ticks + 1 ticks, so the answer is that or
     // one of the next smaller nice steps.
-    let raw = (hi - lo) / max_ticks.max(1) as f64;
+    let n = max_ticks.max(1) as f64;
+    let raw = hi / n - lo / n;
     let decade = raw.log10().floor() as i32;
     let steps: Vec<f64> = (decade - 1..=decade + 1)
         .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
@@ -229,13 +232,16 @@ pub fn log_ticks(lo: f64, hi: f64, max_ticks: usize) -> (Vec<f64>, Vec<f64>) {
     (ticks, Vec::new())
 }
 
+/// The magnitudes written in fixed notation; others in scientific, where fixed would be long.
+const FIXED: std::ops::Range<f64> = 1e-3..1e5;
+
 /// A tick label with the decimals that `step` needs; scientific notation for large or small
 /// magnitudes (`scale`: the largest magnitude on the axis), where fixed notation would be long.
 pub fn linear_label(value: f64, step: f64, scale: f64) -> String {
     if value == 0.0 {
         return "0".into();
     }
-    if scale >= 1e5 || scale < 1e-3 {
+    if !FIXED.contains(&scale) {
         let digits = (value.abs().log10().floor() - step.log10().floor()).max(0.0) as usize;
         return format!("{value:.digits$e}");
     }
@@ -261,7 +267,7 @@ pub fn short(value: f64) -> String {
     // Rounding through the decimal text gives the double nearest the short decimal, which
     // `{}` then prints as exactly that decimal.
     let rounded: f64 = format!("{value:.5e}").parse().unwrap_or(value);
-    if rounded.abs() >= 1e5 || rounded.abs() < 1e-3 {
+    if !FIXED.contains(&rounded.abs()) {
         format!("{rounded:e}")
     } else {
         format!("{rounded}")
@@ -287,6 +293,13 @@ mod tests {
 
     #[test]
     fn ranges_have_margins_and_never_collapse() {
+        let (lo, hi) = linear_range(&[-f64::MAX, f64::MAX], false);
+        assert_eq!((lo, hi), (f64::MIN, f64::MAX));
+        let step = tick_step(lo, hi, 6, false);
+        assert!(
+            step.is_finite() && !multiples(lo, hi, step).is_empty(),
+            "{step}"
+        );
         assert_eq!(linear_range(&[], false), (0.0, 1.0));
         assert_eq!(linear_range(&[0.0, 10.0], false), (-0.5, 10.5));
         assert_eq!(linear_range(&[2.0], false), (1.8, 2.2));

@@ -83,7 +83,8 @@ impl Ranged for Coord<'_> {
     type FormatOption = DefaultFormatting;
 
     fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
-        let fraction = (value - self.0.lo) / (self.0.hi - self.0.lo);
+        // Halves, so that an axis over ±f64::MAX has a finite length.
+        let fraction = (value / 2.0 - self.0.lo / 2.0) / (self.0.hi / 2.0 - self.0.lo / 2.0);
         let pixels = f64::from(limit.1 - limit.0) * fraction;
         // Far outside the axis (never a drawn point, which the axis range holds) the pixel is
         // clamped rather than wrapped.
