@@ -46,7 +46,7 @@ const MIN_PANEL_SCALE: f64 = 0.6;
 /// ...and shows at most this many outcomes and parameters; every pair still has its own file.
 pub const OVERVIEW_MAX_ROWS: usize = 12;
 pub const OVERVIEW_MAX_COLS: usize = 12;
-/// The overview's heading, at full scale.
+/// The height added to the overview for its heading.
 const HEADER: u32 = 44;
 /// A file-name part is cut to this many characters, so that a pair's name stays well inside
 /// the 255 bytes a file name may have.

@@ -21,7 +21,8 @@ const GRID: RGBColor = RGBColor(215, 215, 215);
 const MINOR_GRID: RGBColor = RGBColor(238, 238, 238);
 const GREY_TEXT: RGBColor = RGBColor(90, 90, 90);
 
-/// Sizes in pixels: text, markers and about how many pixels a tick label needs.
+/// Sizes in pixels: of the title, the other text, the tick labels, the points' radius and the
+/// margin round the chart.
 #[derive(Clone, Copy, Debug)]
 pub struct Sizes {
     pub title: f64,
@@ -32,8 +33,8 @@ pub struct Sizes {
 }
 
 impl Sizes {
-    /// Sizes for a panel `scale` times the 800 × 600 single plot... in proportion to its size,
-    /// with text kept legible in the small panels of a large overview.
+    /// The sizes for a panel `scale` times as large as the 800 × 600 single plot, with text
+    /// kept legible in the small panels of a large overview.
     pub fn scaled(scale: f64) -> Sizes {
         Sizes {
             title: (20.0 * scale).max(12.0),
