@@ -208,6 +208,9 @@ const FORBIDDEN: &[(&str, &[&str], &[&str])] = &[
         ],
         &["crate::contact", "crate::model", "crate::physics"],
     ),
+    // The study's plots draw columns of numbers: nothing of the runs, the files or the pictures
+    // of a run.
+    ("src/study/plots", FRONT, ENGINE),
 ];
 
 #[test]
