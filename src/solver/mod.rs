@@ -534,6 +534,7 @@ fn check_energy(
     }
     let now = commit::with_energy(StepStats::default(), blocks, params.gravity);
     let stage_watch;
+    let has_run_watch = watch.is_some();
     let watch = match watch {
         Some(w) => w,
         None => {
@@ -546,6 +547,14 @@ fn check_energy(
     let ratio = watch.step_gain(&before, &after, work);
     if ratio > 1.0 {
         return Err(Retry::EnergyGain(ratio));
+    }
+    // A step that passes its own bound but would take the run past the watchdog's limit is
+    // redone shorter before the run is called diverged: on the rockfall with a 44 m ground
+    // and δ = 0.0041, the column's open–close chatter at the strike doubled the kinetic energy
+    // in one 4.7 ms step (within the step's bound, not the run's) and stopped the run; a run
+    // that never comes near the limit takes the same steps as before.
+    if has_run_watch && watch.check_after(&after, work).is_err() {
+        return Err(Retry::EnergyGain(ratio.max(1.0)));
     }
     Ok(())
 }

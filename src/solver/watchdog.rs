@@ -121,6 +121,20 @@ impl EnergyWatch {
         ))
     }
 
+    /// [`Self::check`] of the state a step would end in: `after` (kinetic, gravitational,
+    /// elastic) with `step_work` of the loads over the step added to the work so far.
+    pub fn check_after(&self, after: &[f64; 3], step_work: f64) -> Result<(), String> {
+        let mut next = self.clone();
+        next.work += step_work;
+        next.work_scale += step_work.abs();
+        next.check(&StepStats {
+            kinetic_energy: after[0],
+            potential_energy: after[1],
+            elastic_energy: after[2],
+            ..Default::default()
+        })
+    }
+
     /// The energy a step would gain, from the kinetic, gravitational and elastic energy
     /// `before` and `after` it and the work of the loads over it, as a multiple of what a step
     /// may gain: [`STEP_GAIN_LIMIT`] times its kinetic energy before and after, at least
@@ -201,6 +215,16 @@ mod tests {
             w.step_gain(&[0.0, 1e6, 0.0], &[f64::NAN, 1e6, 0.0], 0.0),
             f64::INFINITY
         );
+    }
+
+    #[test]
+    fn a_step_is_checked_against_the_balance_it_would_end_with() {
+        let w = watch(1000.0);
+        assert!(w.check_after(&[49.0, 1e6, 0.0], 0.0).is_ok());
+        assert!(w.check_after(&[51.0, 1e6, 0.0], 0.0).is_err());
+        // The step's own load work counts, as it will once the step is taken.
+        assert!(w.check_after(&[151.0, 1e6, 0.0], 110.0).is_ok());
+        assert_eq!(w.work, 0.0, "checking does not change the balance");
     }
 
     #[test]
