@@ -15,7 +15,7 @@ from conftest import DATA, cli, skip_or_fail
 STUDY = DATA / "slope16.toml"
 
 
-@pytest.fixture(autouse=True)
+@pytest.fixture(autouse=True, scope="module")
 def need_study():
     if not dda3d._native.HAS_STUDY:
         skip_or_fail("dda3d built without the study module")
