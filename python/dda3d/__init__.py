@@ -32,6 +32,7 @@ from ._errors import (
     StudyError,
 )
 from ._native import Scene, Simulation, __build__, __version__
+from . import study  # light: its Ray and Dask imports wait until used
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -76,11 +77,3 @@ __all__ = [
     "__version__",
 ]
 
-
-def __getattr__(name: str) -> Any:
-    # `dda3d.study` on first use, so that importing dda3d stays light.
-    if name == "study":
-        from . import study
-
-        return study
-    raise AttributeError(f"module 'dda3d' has no attribute {name!r}")
