@@ -20,9 +20,9 @@ from __future__ import annotations
 import csv
 import json
 import os
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Union
 
 from . import _native
 from ._errors import StudyError
@@ -43,7 +43,8 @@ def _require_native() -> None:
 def load(path: PathLike) -> "_native.Study":
     """Loads and checks a study file. The result has ``len(study)``, ``study.keys()`` (the
     varied keys), ``study.outcomes()``, ``study.task_json(k)`` (case k's task),
-    ``study.assemble(out, records)`` and ``study.finished_json(out)``. Raises ``StudyError``."""
+    ``study.assemble(out, records)``, ``study.save_record(out, record)`` and
+    ``study.finished_json(out)``. Raises ``StudyError``."""
     _require_native()
     return _native.load_study(os.fspath(path))
 
@@ -56,8 +57,9 @@ def run_task_json(task: str) -> str:
 
 
 def default_out(path: PathLike) -> Path:
-    """The output directory when none is given: out/<study file's stem>."""
-    return Path("out") / Path(os.fspath(path)).stem
+    """The output directory when none is given, as `dda3d study` takes it: out/<the study
+    file's stem as a slug>."""
+    return Path("out") / _native.slug(Path(os.fspath(path)).stem)
 
 
 def _pending(study: Any, out: Path, retry_failed: bool) -> "tuple[list[str], list[int]]":
@@ -73,45 +75,44 @@ def _pending(study: Any, out: Path, retry_failed: bool) -> "tuple[list[str], lis
     return kept, [k for k in range(len(study)) if k not in done]
 
 
-def _local(tasks: Sequence[str], jobs: Optional[int]) -> List[str]:
+Done = Callable[[str], None]
+
+
+def _local(tasks: Sequence[str], jobs: Optional[int], done: Done) -> None:
     workers = jobs or os.cpu_count() or 1
     with ThreadPoolExecutor(max_workers=workers) as pool:
-        return list(pool.map(run_task_json, tasks))
+        for f in as_completed([pool.submit(run_task_json, t) for t in tasks]):
+            done(f.result())
 
 
-def _ray(tasks: Sequence[str], jobs: Optional[int]) -> List[str]:
+def _ray(tasks: Sequence[str], jobs: Optional[int], done: Done) -> None:
     import ray
 
     if not ray.is_initialized():
-        # address="auto" finds a cluster started with `ray start`; else a local one.
+        # RAY_ADDRESS=auto finds a cluster started with `ray start`; unset, a local one.
         ray.init(address=os.environ.get("RAY_ADDRESS"))
-    # One CPU a case; `jobs` caps how many run at once.
+    # One CPU a case; `jobs` caps how many are in flight at once.
     remote = ray.remote(num_cpus=1)(run_task_json)
-    if not jobs:
-        return ray.get([remote.remote(t) for t in tasks])
-    results: Dict[Any, int] = {}
-    records: List[Optional[str]] = [None] * len(tasks)
-    todo = list(enumerate(tasks))
-    while todo or results:
-        while todo and len(results) < jobs:
-            i, t = todo.pop(0)
-            results[remote.remote(t)] = i
-        ready, _ = ray.wait(list(results), num_returns=1)
+    todo = list(tasks)
+    running: List[Any] = []
+    while todo or running:
+        while todo and (not jobs or len(running) < jobs):
+            running.append(remote.remote(todo.pop(0)))
+        ready, running = ray.wait(running, num_returns=1)
         for ref in ready:
-            records[results.pop(ref)] = ray.get(ref)
-    return [r for r in records if r is not None]
+            done(ray.get(ref))
 
 
-def _dask(tasks: Sequence[str], jobs: Optional[int], client: Any) -> List[str]:
-    from distributed import Client, LocalCluster
+def _dask(tasks: Sequence[str], jobs: Optional[int], client: Any, done: Done) -> None:
+    from distributed import Client, LocalCluster, as_completed as finished
 
     own = client is None
     if own:
         cluster = LocalCluster(n_workers=jobs or os.cpu_count() or 1, threads_per_worker=1)
         client = Client(cluster)
     try:
-        futures = client.map(run_task_json, list(tasks), pure=False)
-        return client.gather(futures)
+        for f in finished(client.map(run_task_json, list(tasks), pure=False)):
+            done(f.result())
     finally:
         if own:
             client.close()
@@ -156,13 +157,20 @@ def run(
     out = Path(os.fspath(out)) if out is not None else default_out(path)
     kept, cases = _pending(study, out, retry_failed)
     tasks = [study.task_json(k) for k in cases]
+    records = list(kept)
+
+    def done(record: str) -> None:
+        # Saved as it arrives, as `dda3d study` saves each case: a stopped study resumes.
+        study.save_record(os.fspath(out), record)
+        records.append(record)
+
     if backend == "local":
-        new = _local(tasks, jobs)
+        _local(tasks, jobs, done)
     elif backend == "ray":
-        new = _ray(tasks, jobs)
+        _ray(tasks, jobs, done)
     else:
-        new = _dask(tasks, jobs, client)
-    study.assemble(os.fspath(out), kept + list(new))
+        _dask(tasks, jobs, client, done)
+    study.assemble(os.fspath(out), records)
     return read_table(out)
 
 

@@ -18,10 +18,18 @@ use pyo3::prelude::*;
 /// The crate version and a hash of the sources this extension was built from (see build.rs).
 const BUILD: &str = env!("DDA3D_BUILD");
 
+/// A directory name from a name, as `dda3d run` and `dda3d study` name their default output
+/// directories: lower case, runs of other characters as `-`, at most 100 characters.
+#[pyfunction]
+fn slug(name: &str) -> String {
+    dda3d::output::slug(name)
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::PyScene>()?;
     m.add_class::<simulation::PySimulation>()?;
+    m.add_function(wrap_pyfunction!(slug, m)?)?;
     m.add("__build__", BUILD)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("HAS_STUDY", cfg!(feature = "study"))?;

@@ -64,6 +64,13 @@ impl PyStudy {
             .map_err(study_error)
     }
 
+    /// Writes a finished case's record (its JSON) into `out/cases/` as `dda3d study` does as
+    /// each case finishes, atomically: what a resumed study skips.
+    fn save_record(&self, out: PathBuf, record: &str) -> PyResult<()> {
+        let record = CaseRecord::from_json(record).map_err(study_error)?;
+        dda3d::study::table::write_record(&out, &record).map_err(study_error)
+    }
+
     /// The records already finished in `out` (for resuming), as JSON texts; empty when none.
     fn finished_json(&self, out: PathBuf) -> PyResult<Vec<String>> {
         let done = self.study.finished(&out).map_err(study_error)?;
