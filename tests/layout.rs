@@ -23,6 +23,8 @@ fn sources() -> Vec<(String, String)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files = Vec::new();
     rust_files(&root.join("src"), &mut files);
+    // The Python package's extension (python/src, a second crate) keeps the same sizes.
+    rust_files(&root.join("python/src"), &mut files);
     files.sort();
     files
         .into_iter()

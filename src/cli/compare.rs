@@ -91,10 +91,10 @@ fn interval(given: Option<f64>, scene: Option<f64>, duration: f64) -> Result<f64
 }
 
 /// One of the two runs.
-struct Side<'a> {
+struct Side {
     name: &'static str,
     solver: Solver,
-    rec: Record<'a>,
+    rec: Record,
     /// How the run ended, once it has.
     end: Option<End>,
     /// The state after the step before the last, and after the last.
@@ -102,8 +102,8 @@ struct Side<'a> {
     now: Sample,
 }
 
-impl<'a> Side<'a> {
-    fn new(name: &'static str, solver: Solver, rec: Record<'a>) -> Self {
+impl Side {
+    fn new(name: &'static str, solver: Solver, rec: Record) -> Self {
         let now = Sample::of(&solver.snapshot());
         Side {
             name,

@@ -80,7 +80,7 @@ impl Signal {
 }
 
 /// How a command failed. Each kind has its exit status; the message is one line.
-#[derive(Debug)]
+#[derive(Clone, Debug)]
 pub enum Failure {
     Input(String),
     Diverged(String),

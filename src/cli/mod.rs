@@ -5,7 +5,8 @@
 //! One file per subcommand, each with its clap arguments and its entry function:
 //! [`run`](run()) (headless simulation), [`render`](render()) (PNG frames), [`generate`](generate())
 //! (scene files), [`cut`](cut()) (rock masses to blocks), [`study`](study()) (parameter studies),
-//! [`bench`](bench()) and [`view`](view()) (the interactive viewer). The command
+//! [`bench`](bench()) and [`view`](view()) (the interactive viewer). [`RunSession`] is `run`
+//! driven a step at a time by another program (the Python package). The command
 //! line is a contract: flags, defaults, help texts and exit statuses stay as they are.
 
 mod bench;
@@ -17,6 +18,7 @@ mod render;
 mod render_compare;
 mod resume;
 mod run;
+mod session;
 mod study;
 mod view;
 
@@ -36,6 +38,7 @@ pub use cut::{CutArgs, cut};
 pub use generate::{GenerateArgs, GeneratedKind, generate};
 pub use render::{RenderArgs, render};
 pub use run::{Progress, RunArgs, run};
+pub use session::RunSession;
 pub use study::{StudyArgs, study};
 pub use view::{ViewArgs, view};
 

@@ -163,6 +163,10 @@ impl End {
             End::Diverged(e) => ("diverged", Some(e.to_string())),
             End::Interrupted(s) => ("interrupted", Some(format!("stopped by {}", s.name()))),
             End::Io(e) => ("io_error", Some(e.to_string())),
+            End::Stopped(time) => (
+                "interrupted",
+                Some(format!("stopped by the caller at t = {} s", short(*time))),
+            ),
         }
     }
 }
@@ -177,15 +181,18 @@ pub(super) enum End {
     Diverged(SolverError),
     Interrupted(Signal),
     Io(OutputError),
+    /// Closed before its end by the program driving it ([`super::RunSession::close`]), at
+    /// this simulated time.
+    Stopped(f64),
 }
 
 /// The outputs of a run as it goes: rows every step, and at every [`CHECKPOINT`] both CSV
 /// files committed to the same step and summary.json rewritten as "running".
-pub(super) struct Record<'a> {
+pub(super) struct Record {
     writer: RunWriter,
     /// The ParaView series, if asked for.
     vtk: Option<VtkWriter>,
-    scene: &'a str,
+    scene: String,
     method: Method,
     mode: Mode,
     start: Instant,
@@ -195,13 +202,13 @@ pub(super) struct Record<'a> {
     states: Checkpoints,
 }
 
-impl<'a> Record<'a> {
+impl Record {
     /// The outputs of `solver`'s run in `out`: the CSV files, the VTK series when `vtk` gives
     /// its interval (`Some(None)`: every step), and the checkpoints every `every`.
     pub(super) fn create(
         out: &Path,
         solver: &Solver,
-        scene: &'a str,
+        scene: &str,
         rock_masses: Vec<RockMassReport>,
         vtk: Option<Option<f64>>,
         every: Option<f64>,
@@ -214,7 +221,7 @@ impl<'a> Record<'a> {
         Ok(Record {
             writer,
             vtk,
-            scene,
+            scene: scene.to_string(),
             rock_masses,
             method: solver.params.method,
             mode: solver.params.mode,
@@ -227,7 +234,7 @@ impl<'a> Record<'a> {
     fn summary(&self, solver: &Solver, status: &str) -> Summary {
         let wall = self.start.elapsed().as_secs_f64();
         let (method, mode) = (self.method.as_str(), self.mode.as_str());
-        let mut s = Summary::new(self.scene, method, mode, solver.time, wall, &solver.totals);
+        let mut s = Summary::new(&self.scene, method, mode, solver.time, wall, &solver.totals);
         s.status = status.into();
         s.written_time = self.writer.written_time();
         s.equilibrium = solver.equilibrium();
@@ -293,21 +300,32 @@ impl<'a> Record<'a> {
     }
 }
 
+/// The start of a run, before its first step: a first summary.json at once (so even a run
+/// killed in its first second says so), the initial equilibrium stage, and the rows of the
+/// state the run starts from. `Some(end)` when the run ended there.
+pub(super) fn begin(
+    solver: &mut Solver,
+    rec: &mut Record,
+    scene: &Path,
+    quiet: bool,
+) -> Result<Option<End>, OutputError> {
+    rec.checkpoint(solver)?;
+    let settled = settle(solver, scene, quiet);
+    if let Ok(Some(signal)) = settled {
+        return Ok(Some(End::Interrupted(signal)));
+    }
+    // A failed equilibrium stage still writes the state it reached, as a diverged step does.
+    rec.write(&solver.snapshot())?;
+    Ok(settled.err().map(End::Diverged))
+}
+
 /// Steps the run to its end, a divergence, a stop signal or a failed write. A signal that
 /// arrives during a step lets the step finish and its rows be written.
 fn advance(solver: &mut Solver, rec: &mut Record, args: &RunArgs) -> End {
     let mut progress = Progress::new(solver.params.duration, args.quiet);
     let end = (|| {
-        // A first summary.json at once, so even a run killed in its first second says so.
-        rec.checkpoint(solver)?;
-        let settled = settle(solver, args.source(), args.quiet);
-        if let Ok(Some(signal)) = settled {
-            return Ok(End::Interrupted(signal));
-        }
-        // A failed equilibrium stage still writes the state it reached, as a diverged step does.
-        rec.write(&solver.snapshot())?;
-        if let Err(e) = settled {
-            return Ok(End::Diverged(e));
+        if let Some(end) = begin(solver, rec, args.source(), args.quiet)? {
+            return Ok(end);
         }
         while !solver.finished() {
             if let Some(signal) = exit::interrupted() {
@@ -368,7 +386,7 @@ pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
     let mut rec = Record::create(&out, &solver, &name, rock_masses, vtk, every)?;
     let end = advance(&mut solver, &mut rec, args);
     let (end, saved) = rec.close(&solver, end);
-    report(&solver, &rec, end, saved, args)
+    report(&solver, &rec, end, saved, (args.source(), args.quiet))
 }
 
 /// What a run starts from: the solver (the scene's, or the checkpoint's), the rock masses cut
@@ -393,13 +411,14 @@ fn start(args: &RunArgs) -> Result<Start, Failure> {
     ))
 }
 
-/// The outcome as one line on stderr (or none) and an exit status.
-fn report(
+/// The outcome as one line on stderr (or none, when `quiet`) and an exit status; `scene` is
+/// the file the run came from, for messages.
+pub(super) fn report(
     solver: &Solver,
     rec: &Record,
     end: End,
     saved: Result<(), OutputError>,
-    args: &RunArgs,
+    (scene, quiet): (&Path, bool),
 ) -> Result<(), Failure> {
     let out = rec.writer.dir().display();
     let kept = match rec.writer.written_time() {
@@ -414,7 +433,7 @@ fn report(
         (_, Err(e)) => Err(Failure::Io(format!("{e}; {kept}"))),
         (End::Diverged(e), Ok(())) => Err(Failure::Diverged(format!(
             "{}: {e}; results up to t = {} s are in {out}",
-            args.source().display(),
+            scene.display(),
             short(solver.time)
         ))),
         (End::Interrupted(signal), Ok(())) => Err(Failure::Interrupted(
@@ -426,8 +445,9 @@ fn report(
                 solver.totals.steps
             ),
         )),
+        (End::Stopped(_), Ok(())) => Ok(()),
         (End::Completed, Ok(())) => {
-            if !args.quiet {
+            if !quiet {
                 eprintln!(
                     "{}: {} steps to t = {} s in {} s wall; max penetration {} m; results in {out}",
                     rec.scene,
