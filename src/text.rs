@@ -35,6 +35,23 @@ fn trim(s: &str) -> String {
     }
 }
 
+/// `text` on one line: control characters (a newline in a name, a key or a path) written as
+/// escapes, so that an error message stays the one line the command line promises.
+pub fn one_line(text: &str) -> String {
+    if !text.chars().any(char::is_control) {
+        return text.to_string();
+    }
+    text.chars()
+        .map(|c| {
+            if c.is_control() {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::short;

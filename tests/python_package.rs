@@ -16,58 +16,7 @@ fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-/// What the package is built from (python/build.rs's `SOURCES`: keep the two in step).
-const SOURCES: &[&str] = &[
-    "Cargo.toml",
-    "src",
-    "python/Cargo.toml",
-    "python/src",
-    "python/dda3d",
-];
-
-fn files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        out.push(dir.to_path_buf());
-        return;
-    };
-    for entry in entries.flatten() {
-        let path = entry.path();
-        // Not sources: Python's caches, and an extension `maturin develop` put beside them.
-        let name = path.file_name().unwrap_or_default().to_string_lossy();
-        if name == "__pycache__" || [".so", ".pyd", ".pyc"].iter().any(|e| name.ends_with(e)) {
-            continue;
-        }
-        if path.is_dir() {
-            files(&path, out);
-        } else {
-            out.push(path);
-        }
-    }
-}
-
-/// python/build.rs's hash: FNV-1a over each file's relative path and bytes, in path order.
-fn source_hash() -> u64 {
-    let mut all = Vec::new();
-    for s in SOURCES {
-        files(&root().join(s), &mut all);
-    }
-    let mut named: Vec<(String, PathBuf)> = all
-        .into_iter()
-        .map(|p| {
-            let rel = p.strip_prefix(root()).unwrap().to_string_lossy();
-            (rel.replace('\\', "/"), p)
-        })
-        .collect();
-    named.sort();
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for (name, path) in named {
-        let bytes = std::fs::read(&path).unwrap_or_default();
-        for b in name.bytes().chain([0]).chain(bytes).chain([0]) {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
-        }
-    }
-    h
-}
+include!("../python/source_hash.rs");
 
 fn python() -> String {
     std::env::var("DDA3D_PYTHON").unwrap_or_else(|_| "python3".into())
@@ -102,7 +51,7 @@ fn the_python_package_passes_its_tests() {
         }
         Err(why) => panic!("{why}"),
     };
-    let expected = format!("{:016x}", source_hash());
+    let expected = format!("{:016x}", source_hash(root()));
     assert_eq!(
         build.rsplit('+').next().unwrap_or(""),
         expected,

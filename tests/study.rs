@@ -389,3 +389,40 @@ fn max_displacement_follows_the_sliding_block_closed_form() {
         assert_eq!(r.outcomes[3], Some(0.0), "a sliding block does not topple");
     }
 }
+
+/// A study file without `outcomes` tabulates the six, in its order.
+#[test]
+fn a_study_without_outcomes_takes_the_documented_six() {
+    let dir = tmp("default-outcomes");
+    let file = study_file(
+        &dir,
+        "s.toml",
+        "set = { \"solver.duration\" = 0.2 }\n[[parameters]]\nkey = \"joint.friction_angle\"\nvalues = [10.0, 40.0]\n",
+    );
+    let out = dir.join("out");
+    let o = study(&["--quiet"], &file, &out);
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    let table = rows(&out);
+    assert_eq!(
+        table[0],
+        [
+            "case",
+            "joint.friction_angle",
+            "max_displacement",
+            "runout",
+            "blocks_moved",
+            "peak_normal_force",
+            "final_kinetic_energy",
+            "max_penetration",
+            "status",
+            "error"
+        ]
+    );
+    assert_eq!(table.len(), 3);
+    // φ = 10° slides, φ = 40° holds on the 30° slope.
+    let moved = |row: &[String]| row[2].parse::<f64>().unwrap();
+    assert!(
+        moved(&table[1]) > 0.05 && moved(&table[2]) < 1e-3,
+        "{table:?}"
+    );
+}

@@ -45,7 +45,7 @@ use crate::model::{Block, Model, RockMassOf};
 use crate::params::{JointSetParams, SolverParams};
 use crate::physics::geometry::convex_hull;
 use crate::physics::mechanics::Material;
-use crate::text::short;
+use crate::text::{one_line, short};
 use rock_mass::CutBlock;
 
 /// The largest scene file read, in bytes (16 MiB). The largest generated wall (99 998 blocks)
@@ -80,22 +80,6 @@ impl fmt::Display for SceneError {
         // One line, whatever a name or a path in it holds (a block named "a\nb").
         f.write_str(&one_line(&text))
     }
-}
-
-/// Control characters (a newline in a name, say) written as escapes.
-fn one_line(text: &str) -> String {
-    if !text.chars().any(char::is_control) {
-        return text.to_string();
-    }
-    text.chars()
-        .map(|c| {
-            if c.is_control() {
-                c.escape_default().to_string()
-            } else {
-                c.to_string()
-            }
-        })
-        .collect()
 }
 
 impl std::error::Error for SceneError {}

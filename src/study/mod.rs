@@ -65,6 +65,7 @@ pub use keys::override_scene_text;
 pub use outcomes::{Outcome, OutcomeSettings};
 pub use run::{run_task, run_task_until};
 
+use crate::text::one_line;
 use draw::{Distribution, Drawn};
 
 /// The most cases a study may have: a table of a million rows is already more than a plot or a
@@ -107,19 +108,6 @@ impl fmt::Display for StudyError {
 }
 
 impl std::error::Error for StudyError {}
-
-/// Control characters (a newline in a key or a path) written as escapes.
-pub(crate) fn one_line(text: &str) -> String {
-    text.chars()
-        .map(|c| {
-            if c.is_control() {
-                c.escape_default().to_string()
-            } else {
-                c.to_string()
-            }
-        })
-        .collect()
-}
 
 /// One varied key.
 #[derive(Clone, Debug)]

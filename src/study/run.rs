@@ -6,8 +6,9 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::time::Instant;
 
 use super::outcomes::{Outcome, Tracker};
-use super::{CaseRecord, Task, one_line};
+use super::{CaseRecord, Task};
 use crate::solver::Solver;
+use crate::text::one_line;
 use crate::text::short;
 
 /// Why a case did not finish.

@@ -10,6 +10,21 @@ use super::keys::{override_scene_text, value_at};
 use super::outcomes::{Outcome, OutcomeSettings, watched};
 use super::{MAX_CASES, Parameter, Study, StudyError};
 
+/// The outcomes of a study file without `outcomes`: the list (#18) of what a rockfall or
+/// slope study is judged by.
+pub const DEFAULT_OUTCOMES: [&str; 6] = [
+    "max_displacement",
+    "runout",
+    "blocks_moved",
+    "peak_normal_force",
+    "final_kinetic_energy",
+    "max_penetration",
+];
+
+fn default_outcomes() -> Vec<String> {
+    DEFAULT_OUTCOMES.iter().map(|s| s.to_string()).collect()
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct StudyFile {
@@ -17,6 +32,8 @@ struct StudyFile {
     #[serde(default)]
     seed: u64,
     cases: Option<i64>,
+    /// Left out: [`DEFAULT_OUTCOMES`].
+    #[serde(default = "default_outcomes")]
     outcomes: Vec<String>,
     #[serde(default)]
     parameters: Vec<ParameterSpec>,
