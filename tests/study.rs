@@ -426,3 +426,59 @@ fn a_study_without_outcomes_takes_the_documented_six() {
         "{table:?}"
     );
 }
+
+/// `--case K --write-scene FILE` writes case K's scene; `dda3d run` of that file moves the block
+/// as far as the study's record says (so a case can be watched or rerun on its own).
+#[test]
+fn a_case_scene_written_out_runs_to_the_recorded_outcome() {
+    let dir = tmp("write-scene");
+    let file = study_file(
+        &dir,
+        "s.toml",
+        "outcomes = [\"runout\"]\nset = { \"solver.duration\" = 0.4 }\n[[parameters]]\nkey = \"joint.friction_angle\"\nvalues = [10.0, 20.0]\n",
+    );
+    let out = dir.join("out");
+    assert_eq!(study(&["--quiet"], &file, &out).status.code(), Some(0));
+    let recorded: f64 = rows(&out)[2][2].parse().unwrap();
+    let case_scene = dir.join("case1.toml");
+    let o = study(
+        &["--case", "1", "--write-scene", case_scene.to_str().unwrap()],
+        &file,
+        &dir.join("unused"),
+    );
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    assert!(
+        !dir.join("unused").join("study.csv").exists(),
+        "nothing run"
+    );
+    let text = std::fs::read_to_string(&case_scene).unwrap();
+    assert!(text.contains("friction_angle = 20.0"), "{text}");
+    let run_out = dir.join("run");
+    let status = Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        .args(["run", case_scene.to_str().unwrap(), "--quiet", "--out"])
+        .arg(&run_out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let blocks = std::fs::read_to_string(run_out.join("blocks.csv")).unwrap();
+    let xy = |line: &str| -> [f64; 2] {
+        let f: Vec<f64> = line
+            .split(',')
+            .skip(2)
+            .take(2)
+            .map(|v| v.parse().unwrap())
+            .collect();
+        [f[0], f[1]]
+    };
+    let rows: Vec<&str> = blocks
+        .lines()
+        .skip(1)
+        .filter(|l| l.split(',').nth(1) == Some("block"))
+        .collect();
+    let (a, b) = (xy(rows[0]), xy(rows[rows.len() - 1]));
+    let travel = (b[0] - a[0]).hypot(b[1] - a[1]);
+    assert!(
+        (travel - recorded).abs() <= 1e-9 * recorded.max(1e-3),
+        "run {travel} against the study's {recorded}"
+    );
+}

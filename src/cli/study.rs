@@ -32,6 +32,10 @@ pub struct StudyArgs {
     /// failed. The next full run assembles it.
     #[arg(long, value_name = "K")]
     pub case: Option<usize>,
+    /// With --case K: write case K's scene (the base scene with its values set) to FILE and
+    /// run nothing, to watch or rerun the case with `dda3d view FILE` / `dda3d run FILE`.
+    #[arg(long, value_name = "FILE", requires = "case")]
+    pub write_scene: Option<PathBuf>,
     /// Run again the cases whose record says they failed (resuming skips them otherwise).
     #[arg(long)]
     pub retry_failed: bool,
@@ -57,6 +61,11 @@ pub(super) fn execute(args: &StudyArgs) -> Result<(), Failure> {
         return Err(Failure::Input("--jobs 0: give at least one".into()));
     }
     let study = Study::load(&args.study).map_err(failure)?;
+    if let (Some(k), Some(file)) = (args.case, &args.write_scene) {
+        let task = study.task(k).map_err(failure)?;
+        return crate::output::write_atomically(file, task.scene_text.as_bytes())
+            .map_err(|e| Failure::Io(format!("{}: cannot write: {e}", file.display())));
+    }
     let out = args.out.clone().unwrap_or_else(|| {
         let stem = args.study.file_stem().unwrap_or_default().to_string_lossy();
         PathBuf::from("out").join(slug(&stem))
