@@ -41,11 +41,22 @@ fn override_pairs(
 
 /// A Python value (numbers, strings, booleans, lists and dicts of them) as a TOML value.
 pub fn to_toml(py: Python<'_>, value: &Bound<'_, PyAny>) -> Result<toml::Value, String> {
+    // allow_nan=False: json.dumps writes NaN and Infinity, which are not JSON, as bare words,
+    // and serde_json's complaint about them ("expected value at line 1 column 7") names nothing.
+    let kwargs = pyo3::types::PyDict::new(py);
+    kwargs
+        .set_item("allow_nan", false)
+        .map_err(|e| e.to_string())?;
     let json: String = py
         .import("json")
-        .and_then(|j| j.call_method1("dumps", (value,)))
+        .and_then(|j| j.call_method("dumps", (value,), Some(&kwargs)))
         .and_then(|s| s.extract())
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| match e.get_type(py).name() {
+            Ok(n) if n == "ValueError" => {
+                "a number is NaN or infinite: a scene takes finite numbers".to_string()
+            }
+            _ => e.to_string(),
+        })?;
     let json: serde_json::Value = serde_json::from_str(&json).map_err(|e| e.to_string())?;
     toml::Value::try_from(json).map_err(|e| format!("not a TOML value: {e}"))
 }

@@ -141,6 +141,8 @@ def test_from_dict_reads_the_scene_structure():
     assert z == pytest.approx(0.5 - 0.5 * 9.8 * sim.time**2, rel=1e-6)
     with pytest.raises(dda3d.SceneError, match="colour"):
         dda3d.Scene.from_dict({**d, "colour": "red"})
+    with pytest.raises(dda3d.SceneError, match="NaN or infinite"):
+        dda3d.Scene.from_dict({**d, "solver": {"duration": float("nan")}})
 
 
 def test_a_diverging_run_raises_solver_error_and_keeps_its_files(tmp_path):
