@@ -482,3 +482,28 @@ fn a_case_scene_written_out_runs_to_the_recorded_outcome() {
         "run {travel} against the study's {recorded}"
     );
 }
+
+/// Every study shipped in studies/ loads, and its first case runs to an ok record.
+#[test]
+fn shipped_studies_load_and_their_first_case_runs() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("studies");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 2, "{files:?}");
+    for file in files {
+        let study = Study::load(&file).unwrap_or_else(|e| panic!("{e}"));
+        assert!(!study.is_empty());
+        let record = run_task(&study.task(0).unwrap());
+        assert!(record.is_ok(), "{}: {:?}", file.display(), record.error);
+        assert!(
+            record
+                .outcomes
+                .iter()
+                .all(|o| o.is_some_and(f64::is_finite))
+        );
+    }
+}
