@@ -9,11 +9,10 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
 mod window_support;
 
-use window_support::{have_xvfb_run, skip_or_fail};
+use window_support::{finish, have_xvfb_run, skip_or_fail};
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_dda3d"))
@@ -70,23 +69,6 @@ fn difference(img: &image::RgbImage, a: [u32; 4], b: [u32; 2]) -> f64 {
 fn reported_time(line: &str) -> Option<f64> {
     let rest = line.split("steps to t = ").nth(1)?;
     rest.split_whitespace().next()?.parse().ok()
-}
-
-/// Runs a command to its end (at most 300 s); its status and stderr.
-fn finish(mut child: std::process::Child) -> (std::process::ExitStatus, String) {
-    let deadline = Instant::now() + Duration::from_secs(300);
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            panic!("the command did not exit within 300 s");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
-    let out = child.wait_with_output().unwrap();
-    (status, String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
 #[test]

@@ -7,11 +7,10 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
-use std::time::{Duration, Instant};
 
 mod window_support;
 
-use window_support::{have_xvfb_run, skip_or_fail};
+use window_support::{finish, have_xvfb_run, skip_or_fail};
 
 const WIDTH: u32 = 1280;
 const HEIGHT: u32 = 720;
@@ -75,7 +74,7 @@ fn window_screenshot_under_xvfb() {
     let png = dir.join("window.png");
     let runtime = dir.join("xdg");
     std::fs::create_dir_all(&runtime).unwrap();
-    let mut child = Command::new("xvfb-run")
+    let child = Command::new("xvfb-run")
         // -a: a free display number, so parallel runs do not collide.
         .args(["-a", "-s", "-screen 0 1600x900x24"])
         .arg(env!("CARGO_BIN_EXE_dda3d"))
@@ -92,19 +91,7 @@ fn window_screenshot_under_xvfb() {
         .stderr(Stdio::piped())
         .spawn()
         .expect("start xvfb-run");
-    let deadline = Instant::now() + Duration::from_secs(300);
-    let status = loop {
-        if let Some(s) = child.try_wait().unwrap() {
-            break s;
-        }
-        if Instant::now() > deadline {
-            let _ = child.kill();
-            panic!("the viewer did not exit within 300 s");
-        }
-        std::thread::sleep(Duration::from_millis(50));
-    };
-    let out = child.wait_with_output().unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let (status, stderr) = finish(child);
     if !status.success() {
         if stderr.contains("no GPU adapter") {
             skip_or_fail(

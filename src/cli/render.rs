@@ -91,6 +91,36 @@ pub(super) struct Simulated {
     pub interrupted: Option<Signal>,
 }
 
+impl Simulated {
+    pub(super) fn new() -> Self {
+        Simulated {
+            seconds: 0.0,
+            failure: None,
+            interrupted: None,
+        }
+    }
+
+    /// Steps `solver` up to the frame time `t` (to within round-off of the frame spacing
+    /// `frame_dt`), counting its wall time; false when a stop signal (checked between steps: a
+    /// frame cut short is not submitted) or a solver failure ends the run, with the reason kept.
+    pub(super) fn step_to(&mut self, solver: &mut Solver, t: f64, frame_dt: f64) -> bool {
+        while solver.time < t - 1e-9 * frame_dt {
+            self.interrupted = exit::interrupted();
+            if self.interrupted.is_some() {
+                return false;
+            }
+            let ts = Instant::now();
+            let r = solver.step_until(t);
+            self.seconds += ts.elapsed().as_secs_f64();
+            if let Err(e) = r {
+                self.failure = Some(e);
+                return false;
+            }
+        }
+        true
+    }
+}
+
 /// A capture failure with its exit status: a file that cannot be written is an I/O error, a
 /// missing GPU or bad options bad input, and the rest (the device, a worker) a failure of
 /// neither.
@@ -276,37 +306,20 @@ fn simulate_frames(
     capture: &FrameCapture,
     args: &RenderArgs,
 ) -> Result<Simulated, RenderError> {
-    let mut seconds = 0.0;
+    let mut simulated = Simulated::new();
     let frame_dt = 1.0 / args.fps;
     let total_frames = (solver.params.duration * args.fps + 1e-9).floor() as u64 + 1;
     let mut progress = Progress::new(solver.params.duration, args.quiet);
     capture.submit(solver.snapshot())?;
-    let (mut failure, mut interrupted) = (None, None);
-    'frames: for k in 1..total_frames {
-        let t = k as f64 * frame_dt;
-        while solver.time < t - 1e-9 * frame_dt {
-            // Between steps: a frame cut short is not submitted.
-            interrupted = exit::interrupted();
-            if interrupted.is_some() {
-                break 'frames;
-            }
-            let ts = Instant::now();
-            let r = solver.step_until(t);
-            seconds += ts.elapsed().as_secs_f64();
-            if let Err(e) = r {
-                failure = Some(e);
-                break 'frames;
-            }
+    for k in 1..total_frames {
+        if !simulated.step_to(solver, k as f64 * frame_dt, frame_dt) {
+            break;
         }
         capture.submit(solver.snapshot())?;
         progress.update(solver.time);
     }
     progress.finish();
-    Ok(Simulated {
-        seconds,
-        failure,
-        interrupted,
-    })
+    Ok(simulated)
 }
 
 /// Writes render_summary.json (atomically): frame count, size, adapter, where the time went,

@@ -67,37 +67,20 @@ fn simulate_pairs(
     capture: &FrameCapture,
     args: &RenderArgs,
 ) -> Result<Simulated, RenderError> {
-    let mut seconds = 0.0;
+    let mut simulated = Simulated::new();
     let frame_dt = 1.0 / args.fps;
     let duration = a.params.duration.min(b.params.duration);
     let total_frames = (duration * args.fps + 1e-9).floor() as u64 + 1;
     let mut progress = Progress::new(duration, args.quiet);
     capture.submit_pair(a.snapshot(), b.snapshot())?;
-    let (mut failure, mut interrupted) = (None, None);
-    'frames: for k in 1..total_frames {
+    for k in 1..total_frames {
         let t = k as f64 * frame_dt;
-        for solver in [&mut *a, &mut *b] {
-            while solver.time < t - 1e-9 * frame_dt {
-                interrupted = exit::interrupted();
-                if interrupted.is_some() {
-                    break 'frames;
-                }
-                let ts = Instant::now();
-                let r = solver.step_until(t);
-                seconds += ts.elapsed().as_secs_f64();
-                if let Err(e) = r {
-                    failure = Some(e);
-                    break 'frames;
-                }
-            }
+        if !(simulated.step_to(a, t, frame_dt) && simulated.step_to(b, t, frame_dt)) {
+            break;
         }
         capture.submit_pair(a.snapshot(), b.snapshot())?;
         progress.update(a.time);
     }
     progress.finish();
-    Ok(Simulated {
-        seconds,
-        failure,
-        interrupted,
-    })
+    Ok(simulated)
 }

@@ -191,34 +191,11 @@ impl UiState {
 mod tests {
     use super::*;
     use crate::params::Method;
-    use crate::viewer::sim::{RunState, Speed};
 
     /// The rockfall's UiState with a comparison, and a frame of each side at t = 0 (B with the
     /// penalty method).
     fn rockfall() -> (UiState, Frame, Frame) {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scenes")
-            .join("rock_column_rockfall.toml");
-        let scene = crate::scene::load(&path).unwrap();
-        let solver = crate::solver::Solver::new(scene.model.clone(), scene.params.clone());
-        let snap = Arc::new(solver.snapshot());
-        let mut state = UiState::new(&scene, &snap, "test".into());
-        let a = Frame {
-            seq: 1,
-            applied: 0,
-            generation: 0,
-            snapshot: snap,
-            params: scene.params.clone(),
-            state: RunState::Paused,
-            speed: Speed::Max,
-            error: None,
-            notice: None,
-            steps_per_second: 0.0,
-            seconds_per_step: 0.0,
-            running_seconds: 0.0,
-            totals: solver.totals.clone(),
-            max_step_penetration: solver.max_step_penetration(),
-        };
+        let (mut state, a) = crate::viewer::state::tests::rockfall_state(0);
         let mut b = a.clone();
         b.params.method = Method::Penalty;
         state.compare = Some(Box::new(CompareUi::new(&a.params, &b.params)));

@@ -478,8 +478,8 @@ pub(super) mod tests {
         }
     }
 
-    /// The rockfall after `steps` steps, as the panel sees it.
-    fn rockfall_state(steps: usize) -> (UiState, Frame) {
+    /// The rockfall after `steps` steps, as the panel sees it (the comparison's tests too).
+    pub(crate) fn rockfall_state(steps: usize) -> (UiState, Frame) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("scenes")
             .join("rock_column_rockfall.toml");

@@ -1,9 +1,10 @@
 //! What the window tests (tests/viewer.rs, tests/compare_view.rs) share: whether `xvfb-run` is
-//! there, and the GPU policy for skipping. Without `xvfb-run` or a GPU adapter a window test
+//! there, the GPU policy for skipping, and waiting for the window's process. Without `xvfb-run` or a GPU adapter a window test
 //! prints a note and passes, unless `DDA3D_REQUIRE_GPU=1` (set by `.ci/run`) makes that a
 //! failure.
 
-use std::process::{Command, Stdio};
+use std::process::{Child, Command, ExitStatus, Stdio};
+use std::time::{Duration, Instant};
 
 use dda3d::render::gpu_required_by_env;
 
@@ -23,4 +24,21 @@ pub fn have_xvfb_run() -> bool {
         .stderr(Stdio::null())
         .status()
         .is_ok_and(|s| s.success())
+}
+
+/// Runs a command to its end (at most 300 s); its status and stderr.
+pub fn finish(mut child: Child) -> (ExitStatus, String) {
+    let deadline = Instant::now() + Duration::from_secs(300);
+    let status = loop {
+        if let Some(s) = child.try_wait().unwrap() {
+            break s;
+        }
+        if Instant::now() > deadline {
+            let _ = child.kill();
+            panic!("the command did not exit within 300 s");
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let out = child.wait_with_output().unwrap();
+    (status, String::from_utf8_lossy(&out.stderr).into_owned())
 }
