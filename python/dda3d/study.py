@@ -18,7 +18,6 @@ Ray and Dask are imported only when used; ``pip install "dda3d[ray]"`` or ``"dda
 from __future__ import annotations
 
 import csv
-import json
 import os
 from concurrent.futures import ThreadPoolExecutor, as_completed
 from pathlib import Path
@@ -37,8 +36,9 @@ BACKENDS = ("local", "ray", "dask")
 def load(path: PathLike) -> "_native.Study":
     """Loads and checks a study file. The result has ``len(study)``, ``study.keys()`` (the
     varied keys), ``study.outcomes()``, ``study.task_json(k)`` (case k's task),
-    ``study.assemble(out, records)``, ``study.save_record(out, record)`` and
-    ``study.finished_json(out)``. Raises ``StudyError``."""
+    ``study.assemble(out, records)``, ``study.save_record(out, record)``,
+    ``study.finished_json(out)`` and ``study.pending_json(out, retry_failed)``. Raises
+    ``StudyError``."""
     return _native.load_study(os.fspath(path))
 
 
@@ -52,20 +52,7 @@ def run_task_json(task: str) -> str:
 def default_out(path: PathLike) -> Path:
     """The output directory when none is given, as `dda3d study` takes it: out/<the study
     file's stem as a slug>."""
-    return Path("out") / _native.slug(Path(os.fspath(path)).stem)
-
-
-def _pending(study: Any, out: Path, retry_failed: bool) -> "tuple[list[str], list[int]]":
-    """The records to keep from an earlier run in ``out`` and the cases still to run."""
-    kept: List[str] = []
-    done = set()
-    for text in study.finished_json(os.fspath(out)):
-        record = json.loads(text)
-        if retry_failed and record.get("status") != "ok":
-            continue
-        kept.append(text)
-        done.add(int(record["case"]))
-    return kept, [k for k in range(len(study)) if k not in done]
+    return Path(_native.default_study_out(os.fspath(path)))
 
 
 Done = Callable[[str], None]
@@ -148,7 +135,7 @@ def run(
         raise ValueError(f"backend must be one of {', '.join(BACKENDS)}, got {backend!r}")
     study = load(path)
     out = Path(os.fspath(out)) if out is not None else default_out(path)
-    kept, cases = _pending(study, out, retry_failed)
+    kept, cases = study.pending_json(os.fspath(out), retry_failed)
     tasks = [study.task_json(k) for k in cases]
     records = list(kept)
 

@@ -77,6 +77,20 @@ impl PyStudy {
         Ok(done.iter().map(CaseRecord::to_json).collect())
     }
 
+    /// What resuming in `out` starts from, as `dda3d study` resumes: the finished records kept
+    /// (JSON texts; a failed one only without `retry_failed`) and the cases still to run.
+    fn pending_json(
+        &self,
+        out: PathBuf,
+        retry_failed: bool,
+    ) -> PyResult<(Vec<String>, Vec<usize>)> {
+        let (kept, todo) = self
+            .study
+            .pending(&out, retry_failed)
+            .map_err(study_error)?;
+        Ok((kept.iter().map(CaseRecord::to_json).collect(), todo))
+    }
+
     fn __repr__(&self) -> String {
         format!(
             "Study({}, {} cases, keys {:?}, outcomes {:?})",
@@ -104,7 +118,15 @@ fn run_task_json(py: Python<'_>, task: &str) -> PyResult<String> {
     Ok(py.detach(|| run_task(&task).to_json()))
 }
 
+/// The output directory of a study file when none is given, as `dda3d study` takes it:
+/// out/<the file's stem as a slug>.
+#[pyfunction]
+fn default_study_out(path: PathBuf) -> PathBuf {
+    dda3d::study::default_out(&path)
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(default_study_out, m)?)?;
     m.add_class::<PyStudy>()?;
     m.add_function(wrap_pyfunction!(load_study, m)?)?;
     m.add_function(wrap_pyfunction!(run_task_json, m)?)?;

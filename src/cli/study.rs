@@ -14,8 +14,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use super::exit::{self, Failure};
-use crate::output::slug;
-use crate::study::{CaseRecord, Study, StudyError, run_task_until, table};
+use crate::study::{CaseRecord, Study, StudyError, default_out, run_task_until, table};
 use crate::text::short;
 
 #[derive(Args, Debug)]
@@ -66,26 +65,13 @@ pub(super) fn execute(args: &StudyArgs) -> Result<(), Failure> {
         return crate::output::write_atomically(file, task.scene_text.as_bytes())
             .map_err(|e| Failure::Io(format!("{}: cannot write: {e}", file.display())));
     }
-    let out = args.out.clone().unwrap_or_else(|| {
-        let stem = args.study.file_stem().unwrap_or_default().to_string_lossy();
-        PathBuf::from("out").join(slug(&stem))
-    });
-    let finished = study.finished(&out).map_err(failure)?;
+    let out = args.out.clone().unwrap_or_else(|| default_out(&args.study));
+    // Also refuses another study's directory before anything is written, --case included.
+    let (mut records, todo) = study.pending(&out, args.retry_failed).map_err(failure)?;
     if let Some(k) = args.case {
         return one_case(&study, &out, k);
     }
     exit::catch_stop_signals()?;
-    let todo: Vec<usize> = (0..study.len())
-        .filter(|k| {
-            !finished
-                .iter()
-                .any(|r| r.case == *k && (r.is_ok() || !args.retry_failed))
-        })
-        .collect();
-    let mut records: Vec<CaseRecord> = finished
-        .into_iter()
-        .filter(|r| r.is_ok() || !args.retry_failed)
-        .collect();
     // study.json first: it marks the directory as this study's, even if killed at once.
     table::write_tables(&study, &out, &records).map_err(failure)?;
     let start = Instant::now();

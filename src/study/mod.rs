@@ -299,6 +299,31 @@ impl Study {
     pub fn finished(&self, out: &Path) -> Result<Vec<CaseRecord>, StudyError> {
         table::finished(self, out)
     }
+
+    /// What resuming in `out` starts from: the finished records kept (a failed one only
+    /// without `retry_failed`) and the cases still to run, in order. The command and the
+    /// Python runners both resume through this.
+    pub fn pending(
+        &self,
+        out: &Path,
+        retry_failed: bool,
+    ) -> Result<(Vec<CaseRecord>, Vec<usize>), StudyError> {
+        let kept: Vec<CaseRecord> = self
+            .finished(out)?
+            .into_iter()
+            .filter(|r| r.is_ok() || !retry_failed)
+            .collect();
+        let todo = (0..self.len())
+            .filter(|k| !kept.iter().any(|r| r.case == *k))
+            .collect();
+        Ok((kept, todo))
+    }
+}
+
+/// The output directory of a study file when none is given: `out/<its stem as a slug>`.
+pub fn default_out(study_file: &Path) -> PathBuf {
+    let stem = study_file.file_stem().unwrap_or_default().to_string_lossy();
+    PathBuf::from("out").join(crate::output::slug(&stem))
 }
 
 /// A TOML value from a `values` list as the table shows it.
