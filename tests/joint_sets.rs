@@ -402,20 +402,27 @@ fn a_stack_of_slabs_on_a_joint_slides_as_one() {
 /// up, their forces swung by 10⁵ N, and the first stack stopped within a step after 0.15 s
 /// (0.11 m in 0.5 s instead of 0.246 m).
 ///
-/// Not yet measured under that rule: two slabs on 35° (φ 25°), three on 40° with φ 25°, four
-/// cut by an 80° set, which lagged or jammed before it; and the 75° stack with φ above its dip
-/// crept 0.4–1.5 mm in 0.5 s (the README says so).
+/// Three slabs on 40° with φ 25° lagged by 5 % (accelerations 6 % off) until a sliding
+/// contact's friction turned by the trial force instead of the direction of its last slip
+/// (`law::turned`); they are within 0.2 % and 0.4 % now.
+///
+/// Not held to the closed form: four slabs cut by an 80° set. The set dips into the slope, so
+/// the upslope end column overhangs the stack and leans on it: its top block leads (20 mm
+/// against 15 mm at 0.1 s), the blocks below it lag, and the column pushes the rest 4–9 %
+/// beyond Coulomb's travel. That is a mechanism of its own, not a slide as one.
 #[test]
 fn slabs_cut_by_a_cross_set_slide_as_one() {
-    // Also measured (not held to these bounds yet): four slabs cut at 80° travel within 1.6 %;
-    // three on 40°/φ 25° cut at 75° within 5 %. With a 65° cross set the other blocks are within
-    // 1 %, and the top end's 0.08 m³ sliver, lying on the cross joint that dips at 65° out of the
-    // stack's free end face, slides off it and falls (9.2 m/s² over the last 0.3 s), as it should.
+    // Also: with a 65° cross set on 40°/φ 30°, the top end's 0.08 m³ sliver, lying on the cross
+    // joint that dips at 65° out of the stack's free end face, slides off it and falls (9.2 m/s²
+    // over the last 0.3 s), as it should; it is not in this family.
     for (dip, phi, layers, cross) in [
         (40.0f64, 30.0f64, 3, 75.0f64),
         (45.0, 35.0, 3, 75.0),
         (35.0, 25.0, 2, 75.0),
         (40.0, 30.0, 2, 70.0),
+        (40.0, 25.0, 3, 75.0),
+        (35.0, 25.0, 3, 65.0),
+        (30.0, 20.0, 2, 70.0),
     ] {
         let t = 0.5;
         let run = |phi: f64| {
@@ -464,6 +471,41 @@ fn slabs_cut_by_a_cross_set_slide_as_one() {
                     && (a - want).norm() < 0.02 * want.norm(),
                 "dip {dip}, φ {phi}, {layers} slabs, cross {cross}, {}: a = {a:?}, moved \
                  {moved:?}; closed form {want:?}, {travel:?}",
+                b.name
+            );
+        }
+    }
+}
+
+/// Cross-cut stacks whose joints' friction angle is above their dip stand: no block moves
+/// 0.1 mm in 1.5 s. Three slabs on 45° under φ 50°, cut at 75°, crept faster and faster (2.9 mm
+/// in 1.5 s, the downslope end column most) while a sliding corner's friction turned to the
+/// direction of each micrometre slip of the blocks' rocking: τ swung by up to 90° a pass, the
+/// open–close iteration did not converge, and 60 contacts a step were settled in whatever state
+/// they had. Four slabs under φ 48° cut at 80° crept 0.84 mm, three on 30° cut at 65° 0.14 mm.
+#[test]
+fn cross_cut_stacks_with_friction_above_their_dip_stand() {
+    for (dip, phi, layers, cross) in [
+        (45.0, 50.0, 3, 75.0),
+        (45.0, 50.0, 2, 75.0),
+        (40.0, 50.0, 3, 75.0),
+        (35.0, 45.0, 3, 70.0),
+        (40.0, 48.0, 4, 80.0),
+        (30.0, 38.0, 3, 65.0),
+    ] {
+        let mut s = scene::parse(&stack(dip, phi, layers, Some(cross)), "stack.toml", "stack")
+            .unwrap_or_else(|e| panic!("{e}"));
+        s.params.duration = 1.5;
+        let mut solver = Solver::new(s.model, s.params);
+        let start = solver.snapshot();
+        while !solver.finished() {
+            solver.step().expect("runs");
+        }
+        for (b, b0) in solver.snapshot().blocks.iter().zip(&start.blocks) {
+            let crept = (Vec3::from(b.centroid) - Vec3::from(b0.centroid)).norm();
+            assert!(
+                crept < 1e-4,
+                "dip {dip}, φ {phi}, {layers} slabs cut at {cross}°, {}: crept {crept} m",
                 b.name
             );
         }
