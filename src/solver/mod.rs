@@ -32,7 +32,7 @@ use active::Active;
 use attempt::{AttemptInputs, Solved, attempt};
 use counters::{Counters, Stopwatch, debug_log};
 use step_control::Retry;
-use watchdog::EnergyWatch;
+use watchdog::{EnergyWatch, step_gain_limit};
 
 use crate::contact::ContactKey;
 use crate::contact::groups::{Bounds, ContactGroups};
@@ -544,7 +544,7 @@ fn check_energy(
     };
     let before = [now.kinetic_energy, now.potential_energy, now.elastic_energy];
     let (after, work) = commit::energy_after(blocks, d, dt, scheme, params.gravity);
-    let ratio = watch.step_gain(&before, &after, work);
+    let ratio = watch.step_gain(&before, &after, work, step_gain_limit(params.method));
     if ratio > 1.0 {
         return Err(Retry::EnergyGain(ratio));
     }
