@@ -189,14 +189,16 @@ fn vertex_face(
     }
 }
 
-/// The face of `b` whose plane vertex `vi` of `a` lies on (within the tie distance, or behind it
-/// by the least), for a vertex that lies `outside` b by less than the point-in-face slack but
-/// passed only faces far behind it: its face's outline test, widened by `outside`, and the
-/// entrance test. Where J1 (35°) meets an 80° joint, a corner of one slab slid 1.02 cm past the
+/// The face of `b` that separates vertex `vi` of `a` from it, for a vertex that lies `outside` b
+/// by less than the point-in-face slack but passed only faces far behind it: of the faces whose
+/// outline test (widened by `outside`) and entrance test it passes, the one whose plane it is
+/// farthest outside of (for a convex block, the separating plane; its gap is at most
+/// `outside`). Where J1 (35°) meets an 80° joint, a corner of one slab slid 1.02 cm past the
 /// side edge of the J1 face it rested on (slack 1.00 cm), and the only face it still passed was
 /// the far steep face 13 cm behind: taken as a contact that deep, it was held as a 13 cm overlap
-/// and pressed with 16 MN for a step. Dropping such vertices instead (a depth-claim check) made
-/// the slope diverge at 2 s.
+/// and pressed with 16 MN for a step. Another corner, 1 cm above a J1 face and 1 cm past its
+/// side, was taken 11 cm deep the same way. Dropping such vertices instead (a depth-claim check)
+/// made the slope diverge at 2 s: here they keep a contact, at their true gap.
 fn face_beside(
     a: &Shape,
     vi: usize,
@@ -217,7 +219,7 @@ fn face_beside(
     for (fi, face) in b.topo.faces.iter().enumerate() {
         let n = b.face_normals[fi];
         let gap = (pv - b.vertices[face[0]]).dot(&n);
-        if gap > p.tie_distance || best.as_ref().is_some_and(|f| f.gap >= gap) {
+        if best.as_ref().is_some_and(|f| f.gap >= gap) {
             continue;
         }
         let slack = p
@@ -245,7 +247,7 @@ fn face_beside(
             });
         }
     }
-    // Only a face the vertex is (nearly) on: one far behind is the phantom depth again.
+    // Not a face far behind: that is the phantom depth again.
     best.filter(|f| -f.gap <= DEPTH_RATIO * outside + p.tie_distance)
 }
 

@@ -272,35 +272,40 @@ fn far_blocks_have_no_contacts_and_broad_phase_skips_them() {
 }
 
 #[test]
-fn a_vertex_just_past_a_face_edge_is_taken_on_the_face_it_lies_on() {
-    // b: the unit cube. A corner of a lies on b's top plane, 5 mm beyond the side face y = 0:
-    // outside b by 5 mm. `face_beside` gives the top face at its true gap (0), not the far
-    // faces behind the vertex; a vertex deep inside b, or far beyond the edge, gets none.
+fn a_vertex_just_past_a_face_edge_is_taken_on_the_face_that_separates_it() {
+    // b: the unit cube. A corner of a lies 3 mm above b's top plane, 5 mm beyond the side face
+    // y = 0: outside b by 5 mm, the side face's plane separates it. `face_beside` gives that
+    // face at its true gap, not the far faces behind the vertex; 5 mm above the top and 3 mm
+    // beyond the side it gives the top. A vertex deep inside b gets none.
     let b = owned(box_vertices([1.0; 3], [0.5, 0.5, 0.5], &Mat3::identity()));
     let tip = |x: Vec3| {
         owned(vec![
             x,
-            x + Vec3::new(0.2, 0.1, 0.5),
-            x + Vec3::new(-0.2, 0.1, 0.5),
-            x + Vec3::new(0.0, -0.2, 0.5),
+            x + Vec3::new(0.2, -0.1, 0.5),
+            x + Vec3::new(-0.2, -0.1, 0.5),
+            x + Vec3::new(0.0, -0.3, 0.2),
         ])
     };
     let p = params();
     let faces: Vec<f64> = vec![1.0; b.t.faces.len()];
-    let x = Vec3::new(0.5, -0.005, 1.0);
-    let a = tip(x);
-    let vi = a.v.iter().position(|v| (v - x).norm() < 1e-12).unwrap();
-    let f = face_beside(&shape(&a), vi, &shape(&b), &faces, 0.005, &p).expect("the top face");
+    let beside = |x: Vec3, outside: f64| {
+        let a = tip(x);
+        let vi = a.v.iter().position(|v| (v - x).norm() < 1e-12).unwrap();
+        face_beside(&shape(&a), vi, &shape(&b), &faces, outside, &p)
+    };
+    let f = beside(Vec3::new(0.5, -0.005, 1.003), 0.005).expect("the side face");
     assert!(
-        (f.normal - Vec3::z()).norm() < 1e-12 && f.gap.abs() < 1e-12,
+        (f.normal + Vec3::y()).norm() < 1e-12 && (f.gap - 0.005).abs() < 1e-12,
         "{f:?}"
     );
-    let x = Vec3::new(0.5, 0.5, 0.5);
-    let a = tip(x);
-    let vi = a.v.iter().position(|v| (v - x).norm() < 1e-12).unwrap();
-    assert!(face_beside(&shape(&a), vi, &shape(&b), &faces, -0.5, &p).is_none());
-    let x = Vec3::new(0.5, -0.3, 1.0);
-    let a = tip(x);
-    let vi = a.v.iter().position(|v| (v - x).norm() < 1e-12).unwrap();
-    assert!(face_beside(&shape(&a), vi, &shape(&b), &faces, 0.005, &p).is_none());
+    let f = beside(Vec3::new(0.5, -0.003, 1.005), 0.005).expect("the top face");
+    assert!(
+        (f.normal - Vec3::z()).norm() < 1e-12 && (f.gap - 0.005).abs() < 1e-12,
+        "{f:?}"
+    );
+    assert!(beside(Vec3::new(0.5, 0.5, 0.5), -0.5).is_none());
+    // On the top's plane, 2 cm beyond the side: both faces pass the widened outline test, and
+    // the side's plane, 2 cm away, is the one that separates it (the top's gap is 0).
+    let f = beside(Vec3::new(0.5, -0.02, 1.0), 0.02).expect("the side face");
+    assert!((f.normal + Vec3::y()).norm() < 1e-12 && (f.gap - 0.02).abs() < 1e-12);
 }
