@@ -103,13 +103,7 @@ fn vertex_face(
         // the widest slack a passing face allowed it.
         let mut outside = f64::NEG_INFINITY;
         let mut widest_slack = 0.0f64;
-        let vertex_edge = a.topo.vertex_edges[vi]
-            .iter()
-            .map(|&ei| {
-                let e = a.topo.edges[ei];
-                (a.vertices[e.v[1]] - a.vertices[e.v[0]]).norm()
-            })
-            .fold(0.0, f64::max);
+        let vertex_edge = longest_edge_at(a, vi);
         for (fi, face) in b.topo.faces.iter().enumerate() {
             let n = b.face_normals[fi];
             let q0 = b.vertices[face[0]];
@@ -118,41 +112,11 @@ fn vertex_face(
             if gap < -p.max_penetration || gap > p.search_distance {
                 continue;
             }
-            // The slack covers the blind spot the edge–edge test leaves near edge ends (closest
-            // points within ε_e of an end are refused there): a vertex a few millimetres
-            // outside a face, beside the face's edge, is caught here, against the face's plane.
-            // Without it a corner of one block near a corner of another (every joint of a
-            // wall of aligned blocks) is seen by neither test, can move into the neighbour
-            // unseen within a step, and the next step pushes it out with a burst of energy.
-            let slack = p
-                .inside_tolerance
-                .max(2.0 * p.edge_margin * face_edges[fi].max(vertex_edge));
-            let inside = (0..face.len()).all(|m| {
-                let qm = b.vertices[face[m]];
-                let e = b.vertices[face[(m + 1) % face.len()]] - qm;
-                (pv - qm).dot(&n.cross(&e.normalize())) >= -slack
-            });
-            if !inside {
+            let slack = outline_slack(p, face_edges[fi], vertex_edge);
+            if !faces_vertex(a, vi, b, fi, slack, p) {
                 continue;
             }
-            // Entrance: block a lies locally outside the face plane; an edge diving into the
-            // face means the contact is really edge–face or face–face, found by other features.
-            let enters = a.topo.vertex_edges[vi].iter().all(|&ei| {
-                let e = a.topo.edges[ei];
-                let other = if e.v[0] == vi { e.v[1] } else { e.v[0] };
-                let t = a.vertices[other] - pv;
-                t.dot(&n) >= -t.norm() * p.sin_entrance
-            });
-            if !enters {
-                continue;
-            }
-            let [t1, t2, t3] = face_triple(face);
-            passing.push(Alternative {
-                face: fi as u32,
-                corners: [b.vertices[t1], b.vertices[t2], b.vertices[t3]],
-                normal: n,
-                gap,
-            });
+            passing.push(alternative(b, fi, gap));
             widest_slack = widest_slack.max(slack);
         }
         // Block b is convex: a vertex outside the plane of any one of its faces is outside b,
@@ -175,7 +139,7 @@ fn vertex_face(
             // slid past the edge of the face it lies on by a little more than that face's slack
             // allows, and only a far face of b still passed. See `face_beside`. (Without such a
             // face the claim stands: dropped, the vertex could sink into b unseen.)
-            if let Some(f) = face_beside(a, vi, b, &face_edges, outside, p) {
+            if let Some(f) = face_beside(a, vi, b, (&face_edges, vertex_edge), outside, p) {
                 passing = vec![f];
             }
         }
@@ -203,52 +167,85 @@ fn face_beside(
     a: &Shape,
     vi: usize,
     b: &Shape,
-    face_edges: &[f64],
+    (face_edges, vertex_edge): (&[f64], f64),
     outside: f64,
     p: &DetectionParams,
 ) -> Option<Alternative> {
     let pv = a.vertices[vi];
-    let vertex_edge = a.topo.vertex_edges[vi]
+    let mut best: Option<Alternative> = None;
+    for (fi, face) in b.topo.faces.iter().enumerate() {
+        let gap = (pv - b.vertices[face[0]]).dot(&b.face_normals[fi]);
+        if best.as_ref().is_some_and(|f| f.gap >= gap) {
+            continue;
+        }
+        let slack = outline_slack(p, face_edges[fi], vertex_edge) + outside;
+        if faces_vertex(a, vi, b, fi, slack, p) {
+            best = Some(alternative(b, fi, gap));
+        }
+    }
+    // Not a face far behind: that is the phantom depth again.
+    best.filter(|f| -f.gap <= DEPTH_RATIO * outside + p.tie_distance)
+}
+
+/// The longest edge of block `a` at its vertex `vi`, m.
+fn longest_edge_at(a: &Shape, vi: usize) -> f64 {
+    a.topo.vertex_edges[vi]
         .iter()
         .map(|&ei| {
             let e = a.topo.edges[ei];
             (a.vertices[e.v[1]] - a.vertices[e.v[0]]).norm()
         })
-        .fold(0.0, f64::max);
-    let mut best: Option<Alternative> = None;
-    for (fi, face) in b.topo.faces.iter().enumerate() {
-        let n = b.face_normals[fi];
-        let gap = (pv - b.vertices[face[0]]).dot(&n);
-        if best.as_ref().is_some_and(|f| f.gap >= gap) {
-            continue;
-        }
-        let slack = p
-            .inside_tolerance
-            .max(2.0 * p.edge_margin * face_edges[fi].max(vertex_edge))
-            + outside;
-        let inside = (0..face.len()).all(|m| {
-            let qm = b.vertices[face[m]];
-            let e = b.vertices[face[(m + 1) % face.len()]] - qm;
-            (pv - qm).dot(&n.cross(&e.normalize())) >= -slack
-        });
-        let enters = a.topo.vertex_edges[vi].iter().all(|&ei| {
+        .fold(0.0, f64::max)
+}
+
+/// The slack of the point-in-face test for a face whose longest edge is `face_edge` and a
+/// vertex whose longest edge is `vertex_edge`. It covers the blind spot the edge–edge test
+/// leaves near edge ends (closest points within ε_e of an end are refused there): a vertex a
+/// few millimetres outside a face, beside the face's edge, is caught by the vertex–face test,
+/// against the face's plane. Without it a corner of one block near a corner of another (every
+/// joint of a wall of aligned blocks) is seen by neither test, can move into the neighbour
+/// unseen within a step, and the next step pushes it out with a burst of energy.
+fn outline_slack(p: &DetectionParams, face_edge: f64, vertex_edge: f64) -> f64 {
+    p.inside_tolerance
+        .max(2.0 * p.edge_margin * face_edge.max(vertex_edge))
+}
+
+/// Whether vertex `vi` of `a` faces face `fi` of `b`: it lies within the face's outline, up to
+/// `slack`, and passes the entrance test (block a lies locally outside the face plane; an edge
+/// diving into the face means the contact is really edge–face or face–face, found by other
+/// features).
+fn faces_vertex(
+    a: &Shape,
+    vi: usize,
+    b: &Shape,
+    fi: usize,
+    slack: f64,
+    p: &DetectionParams,
+) -> bool {
+    let (face, n, pv) = (&b.topo.faces[fi], b.face_normals[fi], a.vertices[vi]);
+    let inside = (0..face.len()).all(|m| {
+        let qm = b.vertices[face[m]];
+        let e = b.vertices[face[(m + 1) % face.len()]] - qm;
+        (pv - qm).dot(&n.cross(&e.normalize())) >= -slack
+    });
+    inside
+        && a.topo.vertex_edges[vi].iter().all(|&ei| {
             let e = a.topo.edges[ei];
             let other = if e.v[0] == vi { e.v[1] } else { e.v[0] };
             let t = a.vertices[other] - pv;
             t.dot(&n) >= -t.norm() * p.sin_entrance
-        });
-        if inside && enters {
-            let [t1, t2, t3] = face_triple(face);
-            best = Some(Alternative {
-                face: fi as u32,
-                corners: [b.vertices[t1], b.vertices[t2], b.vertices[t3]],
-                normal: n,
-                gap,
-            });
-        }
+        })
+}
+
+/// Face `fi` of `b` as a contact face at `gap`.
+fn alternative(b: &Shape, fi: usize, gap: f64) -> Alternative {
+    let [t1, t2, t3] = face_triple(&b.topo.faces[fi]);
+    Alternative {
+        face: fi as u32,
+        corners: [b.vertices[t1], b.vertices[t2], b.vertices[t3]],
+        normal: b.face_normals[fi],
+        gap,
     }
-    // Not a face far behind: that is the phantom depth again.
-    best.filter(|f| -f.gap <= DEPTH_RATIO * outside + p.tie_distance)
 }
 
 /// The candidate of vertex `vi` (at `xa`) of block `ia` among the faces of block `ib` it passed

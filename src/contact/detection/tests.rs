@@ -291,7 +291,14 @@ fn a_vertex_just_past_a_face_edge_is_taken_on_the_face_that_separates_it() {
     let beside = |x: Vec3, outside: f64| {
         let a = tip(x);
         let vi = a.v.iter().position(|v| (v - x).norm() < 1e-12).unwrap();
-        face_beside(&shape(&a), vi, &shape(&b), &faces, outside, &p)
+        face_beside(
+            &shape(&a),
+            vi,
+            &shape(&b),
+            (&faces, longest_edge_at(&shape(&a), vi)),
+            outside,
+            &p,
+        )
     };
     let f = beside(Vec3::new(0.5, -0.005, 1.003), 0.005).expect("the side face");
     assert!(
