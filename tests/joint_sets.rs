@@ -375,22 +375,27 @@ fn a_stack_of_slabs_on_a_joint_slides_as_one() {
             );
         }
         // The same stack with the friction above the dip stands.
-        let mut s = scene::parse(&stack(dip, dip + 5.0, layers, cross), "stack.toml", "stack")
-            .unwrap_or_else(|e| panic!("{e}"));
-        s.params.duration = t;
-        let mut solver = Solver::new(s.model, s.params);
-        let start = solver.snapshot();
-        while !solver.finished() {
-            solver.step().expect("runs");
-        }
-        for (b, b0) in solver.snapshot().blocks.iter().zip(&start.blocks) {
-            let crept = (Vec3::from(b.centroid) - Vec3::from(b0.centroid)).norm();
-            assert!(
-                crept < 1e-4,
-                "dip {dip}, {layers} slabs, {}: crept {crept} m",
-                b.name
-            );
-        }
+        assert_stack_stands(dip, dip + 5.0, layers, cross, t);
+    }
+}
+
+/// Runs [`stack`] for `duration` from rest and asserts that no block moves 0.1 mm.
+fn assert_stack_stands(dip: f64, phi: f64, layers: u32, cross: Option<f64>, duration: f64) {
+    let mut s = scene::parse(&stack(dip, phi, layers, cross), "stack.toml", "stack")
+        .unwrap_or_else(|e| panic!("{e}"));
+    s.params.duration = duration;
+    let mut solver = Solver::new(s.model, s.params);
+    let start = solver.snapshot();
+    while !solver.finished() {
+        solver.step().expect("runs");
+    }
+    for (b, b0) in solver.snapshot().blocks.iter().zip(&start.blocks) {
+        let crept = (Vec3::from(b.centroid) - Vec3::from(b0.centroid)).norm();
+        assert!(
+            crept < 1e-4,
+            "dip {dip}, φ {phi}, {layers} slabs, cross set {cross:?}, {}: crept {crept} m",
+            b.name
+        );
     }
 }
 
@@ -493,22 +498,7 @@ fn cross_cut_stacks_with_friction_above_their_dip_stand() {
         (40.0, 48.0, 4, 80.0),
         (30.0, 38.0, 3, 65.0),
     ] {
-        let mut s = scene::parse(&stack(dip, phi, layers, Some(cross)), "stack.toml", "stack")
-            .unwrap_or_else(|e| panic!("{e}"));
-        s.params.duration = 1.5;
-        let mut solver = Solver::new(s.model, s.params);
-        let start = solver.snapshot();
-        while !solver.finished() {
-            solver.step().expect("runs");
-        }
-        for (b, b0) in solver.snapshot().blocks.iter().zip(&start.blocks) {
-            let crept = (Vec3::from(b.centroid) - Vec3::from(b0.centroid)).norm();
-            assert!(
-                crept < 1e-4,
-                "dip {dip}, φ {phi}, {layers} slabs cut at {cross}°, {}: crept {crept} m",
-                b.name
-            );
-        }
+        assert_stack_stands(dip, phi, layers, Some(cross), 1.5);
     }
 }
 

@@ -225,40 +225,42 @@ fn generated_wall_struck_by_the_rock_gains_no_energy() {
     assert!(rock.velocity[0] > 1.0, "rock vx {}", rock.velocity[0]);
 }
 
+/// A case of `studies/rockfall_hazard.toml`: the rockfall on its 44 m ground (δ = 0.0041), run
+/// for `duration`, with the rock's `[velocity x, edge, centre height]` as the study drew them.
+fn hazard_case(name: &str, duration: f64, [speed, edge, height]: [f64; 3]) -> Scene {
+    let base = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rock_column_rockfall.toml"),
+    )
+    .unwrap();
+    let overrides: Vec<(String, toml::Value)> = [
+        ("solver.duration", duration),
+        ("solver.max_displacement_ratio", 0.0041),
+        ("blocks.ground.box.size[0]", 44.0),
+        ("blocks.ground.box.size[1]", 44.0),
+        ("blocks.ground.box.center[0]", -14.0),
+        ("blocks.rock.velocity[0]", speed),
+        ("blocks.rock.dodecahedron.edge", edge),
+        ("blocks.rock.dodecahedron.center[2]", height),
+    ]
+    .into_iter()
+    .map(|(k, v)| (k.to_string(), toml::Value::Float(v)))
+    .collect();
+    let text = dda3d::study::override_scene_text(&base, &overrides).unwrap();
+    scene::parse(&text, name, "case").unwrap()
+}
+
 /// A strike that passed each step's own energy bound but took the run past the watchdog's
 /// limit used to stop as diverged (a study of the rockfall with a 44 m ground and δ = 0.0041,
 /// case 61: the column's open–close chatter doubled the kinetic energy in one 4.7 ms step at
 /// t = 0.259 s). Such a step is now redone shorter; the run completes without a gain.
 #[test]
 fn a_step_that_would_break_the_energy_balance_is_redone_shorter() {
-    let base = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rock_column_rockfall.toml"),
-    )
-    .unwrap();
-    let overrides: Vec<(String, toml::Value)> = [
-        ("solver.duration", toml::Value::Float(0.6)),
-        ("solver.max_displacement_ratio", toml::Value::Float(0.0041)),
-        ("blocks.ground.box.size[0]", toml::Value::Float(44.0)),
-        ("blocks.ground.box.size[1]", toml::Value::Float(44.0)),
-        ("blocks.ground.box.center[0]", toml::Value::Float(-14.0)),
-        (
-            "blocks.rock.velocity[0]",
-            toml::Value::Float(-7.344021448633322),
-        ),
-        (
-            "blocks.rock.dodecahedron.edge",
-            toml::Value::Float(0.818600600858745),
-        ),
-        (
-            "blocks.rock.dodecahedron.center[2]",
-            toml::Value::Float(4.859513778999396),
-        ),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), v))
-    .collect();
-    let text = dda3d::study::override_scene_text(&base, &overrides).unwrap();
-    let o = run(scene::parse(&text, "case 61", "case").unwrap());
+    let s = hazard_case(
+        "case 61",
+        0.6,
+        [-7.344021448633322, 0.818600600858745, 4.859513778999396],
+    );
+    let o = run(s);
     assert!(
         (o.solver.time - 0.6).abs() < 1e-9,
         "stopped at {}",
@@ -277,25 +279,11 @@ fn a_step_that_would_break_the_energy_balance_is_redone_shorter() {
 /// contact carries 0.1 GN.
 #[test]
 fn a_step_whose_open_close_iteration_wandered_is_redone_shorter() {
-    let base = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rock_column_rockfall.toml"),
-    )
-    .unwrap();
-    let overrides: Vec<(String, toml::Value)> = [
-        ("solver.duration", 0.6),
-        ("solver.max_displacement_ratio", 0.0041),
-        ("blocks.ground.box.size[0]", 44.0),
-        ("blocks.ground.box.size[1]", 44.0),
-        ("blocks.ground.box.center[0]", -14.0),
-        ("blocks.rock.velocity[0]", -6.324550549544029),
-        ("blocks.rock.dodecahedron.edge", 0.7637594255170174),
-        ("blocks.rock.dodecahedron.center[2]", 8.414697349586472),
-    ]
-    .into_iter()
-    .map(|(k, v)| (k.to_string(), toml::Value::Float(v)))
-    .collect();
-    let text = dda3d::study::override_scene_text(&base, &overrides).unwrap();
-    let s = scene::parse(&text, "case 46", "case").unwrap();
+    let s = hazard_case(
+        "case 46",
+        0.6,
+        [-6.324550549544029, 0.7637594255170174, 8.414697349586472],
+    );
     let mut solver = Solver::new(s.model, s.params);
     let energy =
         |s: &Solver| s.last.kinetic_energy + s.last.potential_energy + s.last.elastic_energy;
