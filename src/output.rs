@@ -262,6 +262,35 @@ impl RowWriter {
     }
 }
 
+/// When the outputs of a run are due: its first state, then every later step, or with an
+/// interval the first step at or past each multiple of it (see [`interval_slot`]). The final
+/// state is written apart, whatever the schedule.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(crate) struct Schedule {
+    /// Simulated time between outputs, s (`None`: every step).
+    interval: Option<f64>,
+}
+
+impl Schedule {
+    pub(crate) fn new(interval: Option<f64>) -> Self {
+        Schedule { interval }
+    }
+
+    /// Whether a state at `time` is written, the last one having been at `last`.
+    pub(crate) fn due(&self, time: f64, last: Option<f64>) -> bool {
+        let Some(last) = last else {
+            return true;
+        };
+        match self.interval {
+            None => time > last,
+            // Steps do not end on the multiples: the slot index of the time decides, with a
+            // relative tolerance so that a step ending a rounding error short of a multiple
+            // counts as reaching it.
+            Some(dt) => interval_slot(time, dt) > interval_slot(last, dt),
+        }
+    }
+}
+
 /// Which interval of length `dt` the time `t` falls in, a step a hair short of a multiple
 /// counted in the next. Outputs at an interval (`--output-interval`, `--checkpoint-every`) take
 /// the first step at or past each multiple: steps do not end on them, and this keeps the

@@ -19,7 +19,7 @@ use clap::Args;
 
 use super::exit::{self, Failure};
 use super::load_scene;
-use super::run::{End, Progress, Record, RunArgs, output_flags, settle, vtk_output};
+use super::run::{End, Progress, Record, RunArgs, output_flags, output_settings, settle};
 use crate::compare::report::{Recorder, Report, RunReport};
 use crate::compare::{CompareSpec, Sample, labels, slope};
 use crate::output::{OutputError, slug, write_atomically};
@@ -217,7 +217,7 @@ pub(super) fn execute(args: &RunArgs, spec: &CompareSpec) -> Result<(), Failure>
         duration,
     )?;
     let out = (args.out.clone()).unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)));
-    let vtk = vtk_output(args, &scene.output)?;
+    let output = output_settings(args, &scene.output);
     exit::catch_stop_signals()?;
     let (labels_a, labels_b) = labels(&scene.params, &params_b);
     let solver_a = Solver::new(scene.model.clone(), scene.params.clone());
@@ -235,7 +235,7 @@ pub(super) fn execute(args: &RunArgs, spec: &CompareSpec) -> Result<(), Failure>
     let name = scene.name;
     let record = |dir: &str, solver: &Solver| {
         let masses = scene.rock_masses.clone();
-        Record::create(&out.join(dir), solver, &name, masses, vtk, every)
+        Record::create(&out.join(dir), solver, &name, masses, output, every)
     };
     let rec_a = record("A", &solver_a)?;
     let rec_b = record("B", &solver_b)?;

@@ -15,7 +15,7 @@ use super::exit::{self, Failure, Signal};
 use super::resume::{self, Checkpoints};
 use super::{CliError, SolverOverrides, load_scene};
 use crate::output::vtk::VtkWriter;
-use crate::output::{OutputError, RunWriter, Summary, slug};
+use crate::output::{OutputError, RunWriter, Schedule, Summary, slug};
 use crate::params::{Method, Mode};
 use crate::rockmass::report::RockMassReport;
 use crate::scene::OutputSettings;
@@ -58,8 +58,9 @@ pub struct RunArgs {
     /// .pvd collections with simulated time); the scene's `[output] vtk = true`
     #[arg(long)]
     pub vtk: bool,
-    /// Simulated time between VTK outputs, s (the scene's `[output] interval`; default: every
-    /// step). The first step at or past each multiple is written, and the final state
+    /// Simulated time between outputs, s: the CSV rows and the VTK series (the scene's
+    /// `[output] interval`; default: every step). The first state, the first step at or past
+    /// each multiple, and the final state are written
     #[arg(long, value_name = "T")]
     pub output_interval: Option<f64>,
 }
@@ -192,6 +193,10 @@ pub(super) struct Record {
     writer: RunWriter,
     /// The ParaView series, if asked for.
     vtk: Option<VtkWriter>,
+    /// When the CSV rows are written (every step without an interval).
+    rows: Schedule,
+    /// The time of the last state whose rows were handed to the writer.
+    last_rows: Option<f64>,
     scene: String,
     method: Method,
     mode: Mode,
@@ -203,24 +208,28 @@ pub(super) struct Record {
 }
 
 impl Record {
-    /// The outputs of `solver`'s run in `out`: the CSV files, the VTK series when `vtk` gives
-    /// its interval (`Some(None)`: every step), and the checkpoints every `every`.
+    /// The outputs of `solver`'s run in `out`: the CSV files and, when `output.vtk` says so,
+    /// the VTK series, both at `output.interval` (every step without one); the checkpoints
+    /// every `every`.
     pub(super) fn create(
         out: &Path,
         solver: &Solver,
         scene: &str,
         rock_masses: Vec<RockMassReport>,
-        vtk: Option<Option<f64>>,
+        output: OutputSettings,
         every: Option<f64>,
     ) -> Result<Self, Failure> {
         let writer = RunWriter::create(out).map_err(|e| Failure::Io(e.to_string()))?;
-        let vtk = vtk
-            .map(|interval| VtkWriter::create(out, interval))
+        let vtk = output
+            .vtk
+            .then(|| VtkWriter::create(out, output.interval))
             .transpose()
             .map_err(|e| Failure::Io(e.to_string()))?;
         Ok(Record {
             writer,
             vtk,
+            rows: Schedule::new(output.interval),
+            last_rows: None,
             scene: scene.to_string(),
             rock_masses,
             method: solver.params.method,
@@ -242,14 +251,24 @@ impl Record {
         s
     }
 
-    /// Rows of the step just completed, and a checkpoint when one is due.
+    /// Rows of the step just completed when they are due, and a checkpoint when one is due.
+    /// The snapshot is taken only for an output.
     pub(super) fn step(&mut self, solver: &Solver) -> Result<(), OutputError> {
-        self.step_with(solver, &solver.snapshot())
+        if self.due(solver.time) {
+            self.step_with(solver, &solver.snapshot())
+        } else {
+            self.after_step(solver)
+        }
     }
 
     /// [`Record::step`] with the solver's snapshot taken already.
     pub(super) fn step_with(&mut self, solver: &Solver, s: &Snapshot) -> Result<(), OutputError> {
         self.write(s)?;
+        self.after_step(solver)
+    }
+
+    /// The checkpoints due after a step.
+    fn after_step(&mut self, solver: &Solver) -> Result<(), OutputError> {
         self.states.after_step(solver, self.writer.dir())?;
         if self.last_checkpoint.elapsed() >= CHECKPOINT {
             self.checkpoint(solver)?;
@@ -257,9 +276,17 @@ impl Record {
         Ok(())
     }
 
-    /// The rows of a state, and its VTK files when an output is due.
+    /// Whether a state at `time` is written: its rows, or its VTK files.
+    fn due(&self, time: f64) -> bool {
+        self.rows.due(time, self.last_rows) || self.vtk.as_ref().is_some_and(|v| v.due(time))
+    }
+
+    /// The rows of a state and its VTK files, each when due.
     pub(super) fn write(&mut self, s: &Snapshot) -> Result<(), OutputError> {
-        self.writer.write(s)?;
+        if self.rows.due(s.time, self.last_rows) {
+            self.writer.write(s)?;
+            self.last_rows = Some(s.time);
+        }
         match &mut self.vtk {
             Some(vtk) => vtk.step(s),
             None => Ok(()),
@@ -282,8 +309,17 @@ impl Record {
         mut end: End,
     ) -> (End, Result<(), OutputError>) {
         if !matches!(end, End::Io(_)) {
-            let last = self.vtk.as_mut().map(|v| v.finish(&solver.snapshot()));
-            if let Err(e) = self.writer.commit().and(last.unwrap_or(Ok(()))) {
+            // The state the run ended in is always written, whatever the interval.
+            let s = solver.snapshot();
+            let rows = match self.last_rows {
+                Some(t) if t == s.time => Ok(()),
+                _ => self.writer.write(&s),
+            };
+            let last = self.vtk.as_mut().map(|v| v.finish(&s));
+            if let Err(e) = rows
+                .and_then(|_| self.writer.commit())
+                .and(last.unwrap_or(Ok(())))
+            {
                 end = End::Io(e);
             }
         }
@@ -354,21 +390,14 @@ pub(super) fn output_flags(args: &RunArgs) -> Result<Option<f64>, Failure> {
     Ok(every)
 }
 
-/// The VTK series a run writes, if any: `Some(interval)` (`Some(None)`: every step). An
-/// interval without the series is a mistake to say: the CSV files take every step.
-pub(super) fn vtk_output(
-    args: &RunArgs,
-    output: &OutputSettings,
-) -> Result<Option<Option<f64>>, Failure> {
-    let write_vtk = args.vtk || output.vtk;
-    if args.output_interval.is_some() && !write_vtk {
-        return Err(Failure::Input(
-            "--output-interval sets the VTK output's interval: add --vtk (or [output] vtk = \
-             true in the scene)"
-                .into(),
-        ));
+/// What a run writes besides the CSV files, and how often: `--vtk` or the scene's
+/// `[output] vtk`, and `--output-interval` over the scene's `[output] interval` (for the CSV
+/// rows and the VTK series alike; every step without one).
+pub(super) fn output_settings(args: &RunArgs, output: &OutputSettings) -> OutputSettings {
+    OutputSettings {
+        vtk: args.vtk || output.vtk,
+        interval: args.output_interval.or(output.interval),
     }
-    Ok(write_vtk.then_some(args.output_interval.or(output.interval)))
 }
 
 /// `dda3d run`, with its failures as [`Failure`]s (their exit statuses). Bad input is
@@ -380,10 +409,10 @@ pub(super) fn execute(args: &RunArgs) -> Result<(), Failure> {
     let every = output_flags(args)?;
     let (mut solver, rock_masses, output, default_out) = start(args)?;
     let out = args.out.clone().unwrap_or(default_out);
-    let vtk = vtk_output(args, &output)?;
+    let output = output_settings(args, &output);
     exit::catch_stop_signals()?;
     let name = solver.model.name.clone();
-    let mut rec = Record::create(&out, &solver, &name, rock_masses, vtk, every)?;
+    let mut rec = Record::create(&out, &solver, &name, rock_masses, output, every)?;
     let end = advance(&mut solver, &mut rec, args);
     let (end, saved) = rec.close(&solver, end);
     report(&solver, &rec, end, saved, (args.source(), args.quiet))

@@ -35,9 +35,9 @@ impl RunSession {
     /// I/O failure naming it.
     pub fn new(scene: Scene, source: &Path, out: Option<&Path>) -> Result<RunSession, Failure> {
         let solver = Solver::new(scene.model, scene.params);
-        let vtk = scene.output.vtk.then_some(scene.output.interval);
+        let output = scene.output;
         let rec = out
-            .map(|dir| Record::create(dir, &solver, &scene.name, scene.rock_masses, vtk, None))
+            .map(|dir| Record::create(dir, &solver, &scene.name, scene.rock_masses, output, None))
             .transpose()?;
         Ok(RunSession {
             solver,

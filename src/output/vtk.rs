@@ -27,14 +27,14 @@ use std::path::{Path, PathBuf};
 
 use base64::Engine;
 
-use super::{OutputError, interval_slot as slot, num, write_atomically};
+use super::{OutputError, Schedule, num, write_atomically};
 use crate::snapshot::{ContactMode, ContactState, Snapshot};
 
 /// Writes the VTK series of a run.
 pub struct VtkWriter {
     dir: PathBuf,
-    /// Simulated time between outputs, s (`None`: every step).
-    interval: Option<f64>,
+    /// When outputs are due.
+    schedule: Schedule,
     /// (time, file name) of each output so far.
     outputs: Vec<(f64, String, String)>,
 }
@@ -47,7 +47,7 @@ impl VtkWriter {
             .map_err(|e| OutputError::io(&dir, "cannot create the VTK directory", e))?;
         Ok(VtkWriter {
             dir,
-            interval,
+            schedule: Schedule::new(interval),
             outputs: Vec::new(),
         })
     }
@@ -69,17 +69,10 @@ impl VtkWriter {
         Ok(())
     }
 
-    fn due(&self, time: f64) -> bool {
-        let Some(&(last, ..)) = self.outputs.last() else {
-            return true;
-        };
-        match self.interval {
-            None => time > last,
-            // Steps do not end on the multiples: the slot index of the time decides, with a
-            // relative tolerance so that a step ending a rounding error short of a multiple
-            // counts as reaching it.
-            Some(dt) => slot(time, dt) > slot(last, dt),
-        }
+    /// Whether a state at `time` is written: the first state, then the first step at or past
+    /// each multiple of the interval (every step without one).
+    pub fn due(&self, time: f64) -> bool {
+        self.schedule.due(time, self.outputs.last().map(|o| o.0))
     }
 
     fn write(&mut self, s: &Snapshot) -> Result<(), OutputError> {

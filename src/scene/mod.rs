@@ -102,7 +102,8 @@ pub struct Scene {
 pub struct OutputSettings {
     /// Write the ParaView series into `DIR/vtk/`.
     pub vtk: bool,
-    /// Simulated time between VTK outputs, s (`None`: every step).
+    /// Simulated time between outputs (the CSV rows and the VTK series), s (`None`: every
+    /// step).
     pub interval: Option<f64>,
 }
 
