@@ -84,8 +84,11 @@ fn open_close_iteration(
         solves: 0,
         settled: false,
     };
+    // Contacts changed in each pass so far.
+    let mut changes: Vec<usize> = Vec::new();
     for pass in 0..=cp.max_open_close_iterations {
-        if pass == cp.max_open_close_iterations {
+        let stalled = open_close::stalled(&changes, active.len());
+        if pass == cp.max_open_close_iterations || stalled {
             open_close::settle_stragglers(active, p, inp.at_floor, counters)?;
             solved.settled = true;
         }
@@ -123,9 +126,10 @@ fn open_close_iteration(
         };
         let changed = open_close::check(&check, &solved.d, active, counters);
         counters.assembly += watch.elapsed();
-        if !changed {
+        if changed == 0 {
             break;
         }
+        changes.push(changed);
     }
     Ok(solved)
 }
