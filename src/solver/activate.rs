@@ -173,6 +173,7 @@ fn activate_one(
         changed: false,
         shear: Vec3::zeros(),
         slip: Vec3::zeros(),
+        du: Vec3::zeros(),
         lateral: 0.0,
         released: 0.0,
     };

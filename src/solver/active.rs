@@ -64,6 +64,10 @@ pub(crate) struct Active {
     pub shear: Vec3,
     /// Δu_ab projected on the tangent plane after the last solve.
     pub slip: Vec3,
+    /// Δu_ab = T_a D_i − T_b D_j of a closed contact in the ALM loop's last solve, taken once
+    /// and read by the stick and friction updates of that iteration (they would each take it
+    /// again from the same D and the same points).
+    pub du: Vec3,
     /// k⊥ of a sliding contact (DDA-3a): the stiffness of its friction's direction across the
     /// slip ([`crate::contact::kinematics::add_friction_tangent`]), N/m; 0 otherwise.
     pub lateral: f64,

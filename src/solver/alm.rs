@@ -72,7 +72,7 @@ pub(crate) fn alm_loop(
         let solves = alm_k;
         let d = solve(inp, sys, active, counters, k_dirty)?;
         let watch = Stopwatch::start();
-        let (conv1, conv2) = measure(p, &d, active);
+        let (conv1, conv2) = measure(p, inp.blocks, &d, active);
         if p.method == Method::Penalty {
             counters.assembly += watch.elapsed();
             return Ok(AlmOutcome {
@@ -81,12 +81,12 @@ pub(crate) fn alm_loop(
                 converged: true,
             });
         }
-        let stuck = stuck(inp, &d, active);
+        let stuck = stuck(inp, active);
         let converged = conv1 && conv2 && stuck;
         // K changes only where (P21) raised a penalty.
-        k_dirty = update_multipliers(p, alm_k, converged, active);
+        k_dirty = update_multipliers(p, (inp.blocks, &d), alm_k, converged, active);
         if !converged && alm_k < cp.max_alm_iterations {
-            absorb_stick_slip(inp, &d, active);
+            absorb_stick_slip(inp, active);
         }
         if !inp.settling {
             hold_reversed_friction(inp, &d, active);
@@ -139,7 +139,7 @@ fn solve(
 /// d_n and N of every contact (5.4), (5.6) for the solution `d`, and the convergence tests
 /// (P23), each contact against its own group's d_n,max, and (P24); an unchanged zero force
 /// vector counts as converged.
-fn measure(p: &SolverParams, d: &[f64], active: &mut [Active]) -> (bool, bool) {
+fn measure(p: &SolverParams, blocks: &[Block], d: &[f64], active: &mut [Active]) -> (bool, bool) {
     // Per contact in parallel; the sums of (P24) are then formed in the contacts' order, so
     // they do not depend on the thread count.
     let terms: Vec<(bool, f64, f64)> = active
@@ -152,6 +152,9 @@ fn measure(p: &SolverParams, d: &[f64], active: &mut [Active]) -> (bool, bool) {
                 return (true, 0.0, 0.0);
             }
             let alm = p.method == Method::Alm;
+            if alm {
+                c.du = c.ta * di - c.tb(blocks) * dj;
+            }
             let lambda = if alm { c.rec.lambda } else { 0.0 };
             c.force = lambda + c.rec.penalty * c.dn;
             let within = c.dn.abs() <= p.contact.eps1 * c.dn_max(p);
@@ -178,6 +181,7 @@ fn measure(p: &SolverParams, d: &[f64], active: &mut [Active]) -> (bool, bool) {
 /// a penalty changed (K must be refactorized).
 fn update_multipliers(
     p: &SolverParams,
+    (blocks, d): (&[Block], &[f64]),
     alm_k: u32,
     converged: bool,
     active: &mut [Active],
@@ -211,6 +215,8 @@ fn update_multipliers(
                 let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
                 if capped > c.rec.penalty {
                     c.set_penalty(capped, cp);
+                    // The spring's reference moved with p_τ, and T_b with it.
+                    c.du = c.relative_displacement(d, blocks);
                     raised = true;
                 }
             }
@@ -220,24 +226,20 @@ fn update_multipliers(
         .reduce(|| false, |a, b| a || b)
 }
 
-/// The tangential relative displacement of a locked contact in the solution `d`, m.
-fn tangential_slip(c: &Active, d: &[f64], blocks: &[Block]) -> crate::physics::geometry::Vec3 {
-    let du = c.relative_displacement(d, blocks);
+/// The tangential part of a closed contact's relative displacement in the last solve, m.
+fn tangential_slip(c: &Active) -> crate::physics::geometry::Vec3 {
     let n = c.cand.normal;
-    du - n * n.dot(&du)
+    c.du - n * n.dot(&c.du)
 }
 
-/// Every locked contact is stuck: its tangential displacement in the solution `d` is within
+/// Every locked contact is stuck: its tangential displacement in the last solve is within
 /// its stick tolerance.
-fn stuck(inp: &AlmInputs, d: &[f64], active: &[Active]) -> bool {
+fn stuck(inp: &AlmInputs, active: &[Active]) -> bool {
     active
         .par_iter()
         .with_min_len(PAR_CONTACTS)
         .filter(|c| c.rec.state == ContactState::Lock)
-        .all(|c| {
-            tangential_slip(c, d, inp.blocks).norm()
-                <= c.stick_tolerance(inp.params, inp.first_step)
-        })
+        .all(|c| tangential_slip(c).norm() <= c.stick_tolerance(inp.params, inp.first_step))
 }
 
 /// The augmented Lagrangian update of a locked contact's shear, as (P1) is of its normal force:
@@ -254,13 +256,13 @@ fn stuck(inp: &AlmInputs, d: &[f64], active: &[Active]) -> bool {
 /// the contact law does not count. With ε1·d_n,max there too, 5 × 10 m blocks took up their load
 /// with 0.12 mm of slip; with f0·w0 in every step, a struck wall of 100 blocks needed 158 solves
 /// a step instead of 99 (57 with no stick update).
-fn absorb_stick_slip(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
+fn absorb_stick_slip(inp: &AlmInputs, active: &mut [Active]) {
     active
         .par_iter_mut()
         .with_min_len(PAR_CONTACTS)
         .for_each(|c| {
             if c.rec.state == ContactState::Lock {
-                let slip = tangential_slip(c, d, inp.blocks);
+                let slip = tangential_slip(c);
                 c.rec.reference -= slip;
                 if !inp.params.joints_held && !inp.first_step {
                     c.cap_shear(inp.params);
@@ -283,6 +285,8 @@ fn hold_reversed_friction(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
             if c.rec.state != ContactState::Slide || c.frozen || c.friction_cap.is_some() {
                 return;
             }
+            // Taken again, not from `du`: a locked contact whose spring `cap_shear` has just let
+            // go slides now, and its T_b is at its point, no longer at the spring's reference.
             let du = c.relative_displacement(d, inp.blocks);
             if law::reversed(&du, &c.rec.tau, c.slip_tolerance(inp.params)) {
                 c.friction_cap = Some(c.rec.lambda);

@@ -4,8 +4,8 @@
 
 use rayon::prelude::*;
 
-use super::PAR_BLOCKS;
 use super::active::{Active, StiffnessKey};
+use super::{PAR_BLOCKS, PAR_CONTACTS};
 use crate::contact::ContactState;
 use crate::contact::kinematics::{
     ContactForces, ContactStiffness, add_friction, add_friction_tangent, add_normal_force,
@@ -168,12 +168,16 @@ pub(crate) fn load_vector(
     active: &[Active],
 ) -> Vec<f64> {
     let mut f: Vec<f64> = f0.iter().flat_map(|v| v.iter().copied()).collect();
-    for c in active.iter() {
-        if c.rec.state == ContactState::Open {
-            continue;
-        }
+    // Each contact's forces in parallel; summed afterwards in the contacts' order, so that F
+    // does not depend on the thread count.
+    let terms: Vec<Option<ContactForces>> = active
+        .par_iter()
+        .with_min_len(PAR_CONTACTS)
+        .map(|c| (c.rec.state != ContactState::Open).then(|| contact_forces(p, blocks, c)))
+        .collect();
+    for (c, t) in active.iter().zip(terms) {
+        let Some(t) = t else { continue };
         let (i, j) = c.blocks();
-        let t = contact_forces(p, blocks, c);
         for a in 0..12 {
             f[12 * i + a] += t.f_i[a];
             f[12 * j + a] += t.f_j[a];
