@@ -100,8 +100,7 @@ pub struct ContactParams {
     /// §6.3). Shi's code uses 6 + 2; in a wall of many blocks, lightly loaded joints need 10–25
     /// passes at the impact, and a pass costs far less than the steps a cut adds. Where at most
     /// [`step_rules::SETTLE_FRACTION`] of the contacts still change at the limit, they are settled
-    /// closed and locked instead of the step being redone; so they are as soon as six passes in a
-    /// row have each changed no more than that (`solver::open_close::stalled`).
+    /// closed and locked instead of the step being redone.
     pub max_open_close_iterations: u32,
     /// Carry λ and p_n of persisting contacts from one step to the next. The paper is silent;
     /// both converge to the same forces, warm starting needs fewer iterations and keeps the

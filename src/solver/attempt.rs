@@ -84,11 +84,8 @@ fn open_close_iteration(
         solves: 0,
         settled: false,
     };
-    // Contacts changed in each pass so far.
-    let mut changes: Vec<usize> = Vec::new();
     for pass in 0..=cp.max_open_close_iterations {
-        let stalled = open_close::stalled(&changes, active.len());
-        if pass == cp.max_open_close_iterations || stalled {
+        if pass == cp.max_open_close_iterations {
             open_close::settle_stragglers(active, p, inp.at_floor, counters)?;
             solved.settled = true;
         }
@@ -126,10 +123,9 @@ fn open_close_iteration(
         };
         let changed = open_close::check(&check, &solved.d, active, counters);
         counters.assembly += watch.elapsed();
-        if changed == 0 {
+        if !changed {
             break;
         }
-        changes.push(changed);
     }
     Ok(solved)
 }

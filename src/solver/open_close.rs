@@ -19,10 +19,6 @@ use crate::physics::geometry::Vec3;
 /// State changes a contact may make in one attempt before it is settled.
 const MAX_FLIPS: u8 = 2;
 
-/// Consecutive passes with few changes after which the iteration counts as stalled (see
-/// [`stalled`]).
-pub(crate) const STALLED_PASSES: usize = 6;
-
 /// What the check of one pass reads.
 pub(crate) struct CheckInputs<'a> {
     pub params: &'a SolverParams,
@@ -36,32 +32,29 @@ pub(crate) struct CheckInputs<'a> {
     pub pass: u32,
 }
 
-/// Classifies every contact from the solution `d` and applies the verdicts. Returns how many
-/// contacts changed state (another pass is needed unless none did).
+/// Classifies every contact from the solution `d` and applies the verdicts. Returns whether a
+/// contact changed state (another pass is needed).
 pub(crate) fn check(
     inp: &CheckInputs,
     d: &[f64],
     active: &mut [Active],
     counters: &mut Counters,
-) -> usize {
+) -> bool {
     // Each contact's verdict depends on its own record and the solution alone, so contacts are
     // checked in parallel (in order when the debug log is on, so that its lines keep their
-    // order); the counts do not depend on the order.
-    let one = |c: &mut Active| {
-        let (changed, frozen) = check_one(inp, d, c);
-        (changed as usize, frozen)
-    };
+    // order); `any` and the count of settled contacts do not depend on the order.
+    let one = |c: &mut Active| check_one(inp, d, c);
     let (changed, frozen) = if debug_log() {
         active
             .iter_mut()
             .map(one)
-            .fold((0, 0), |(a, n), (b, m)| (a + b, n + m))
+            .fold((false, 0), |(a, n), (b, m)| (a || b, n + m))
     } else {
         active
             .par_iter_mut()
             .with_min_len(PAR_CONTACTS)
             .map(one)
-            .reduce(|| (0, 0), |(a, n), (b, m)| (a + b, n + m))
+            .reduce(|| (false, 0), |(a, n), (b, m)| (a || b, n + m))
     };
     counters.totals.frozen_contacts += frozen;
     changed
@@ -177,20 +170,6 @@ fn apply(inp: &CheckInputs, c: &mut Active, verdict: Transition, shear: Vec3) {
     }
 }
 
-/// Whether the open–close iteration has stalled: its last [`STALLED_PASSES`] passes each changed
-/// at least one contact and at most [`SETTLE_FRACTION`] of them. Its stragglers are then
-/// settled at once (see [`settle_stragglers`]) instead of at the pass limit. In a struck wall of
-/// 1000 blocks the passes after the fourth changed 5 to 40 of 10 000 contacts each, a
-/// different few each pass (a contact that flips more than twice is settled already), until
-/// the limit of 30: over its first 0.3 s, 612 passes and 650 factorizations for 43 steps, 16 of
-/// them settled at the limit. Stalled after 6 such passes: 239 passes and 287 factorizations,
-/// 20 steps settled, the same largest penetration. After 4 the wall of 100 blocks settled 39 of
-/// its 82 steps (none before) and took more ALM solves; after 6, 13 steps.
-pub(crate) fn stalled(changes: &[usize], contacts: usize) -> bool {
-    let few = |&n: &usize| n > 0 && n as f64 <= SETTLE_FRACTION * contacts as f64;
-    changes.len() >= STALLED_PASSES && changes[changes.len() - STALLED_PASSES..].iter().all(few)
-}
-
 /// At the open–close pass limit: if more than [`SETTLE_FRACTION`] of the contacts still changed
 /// in the last pass (and the step is above the Δt floor), the attempt is redone with a shorter
 /// step (Shi). Otherwise, and always at the floor, the contacts that still changed are settled
@@ -247,35 +226,4 @@ fn log_change(inp: &CheckInputs, c: &Active, before: ContactState) {
         c.cand.key.i,
         c.cand.key.j
     );
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn an_iteration_stalls_after_passes_of_few_changes_only() {
-        // 10 000 contacts: at most 100 changes a pass count as few.
-        let n = 10_000;
-        assert!(!stalled(&[], n));
-        assert_eq!(STALLED_PASSES, 6);
-        assert!(
-            !stalled(&[40, 30, 20, 9, 8], n),
-            "five passes are not enough"
-        );
-        assert!(stalled(&[40, 30, 20, 10, 9, 8], n));
-        assert!(
-            stalled(&[900, 400, 40, 30, 20, 10, 9, 8], n),
-            "the last six decide"
-        );
-        assert!(
-            !stalled(&[900, 400, 101, 30, 20, 10, 9, 8], n),
-            "101 is more than 1 %"
-        );
-        assert!(!stalled(&[40, 30, 20, 150, 10, 9, 8], n));
-        // A model so small that one contact is more than the fraction never stalls: Shi's rule
-        // (the pass limit, then a shorter step) applies.
-        assert!(!stalled(&[1; 8], 50));
-        assert!(stalled(&[1; 6], 100));
-    }
 }
