@@ -89,7 +89,7 @@ pub(crate) fn alm_loop(
             absorb_stick_slip(inp, active);
         }
         if !inp.settling {
-            hold_reversed_friction(inp, &d, active);
+            hold_reversed_friction(inp, active);
         }
         counters.assembly += watch.elapsed();
         if converged || alm_k == cp.max_alm_iterations {
@@ -277,7 +277,7 @@ fn absorb_stick_slip(inp: &AlmInputs, active: &mut [Active]) {
 /// displacement within 20 iterations, and the open–close check then classified every contact
 /// from that solution. The friction of such a contact is held at its present value for the rest
 /// of the pass (a change of F only: no refactorization); the open–close check locks it.
-fn hold_reversed_friction(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
+fn hold_reversed_friction(inp: &AlmInputs, active: &mut [Active]) {
     active
         .par_iter_mut()
         .with_min_len(PAR_CONTACTS)
@@ -285,10 +285,7 @@ fn hold_reversed_friction(inp: &AlmInputs, d: &[f64], active: &mut [Active]) {
             if c.rec.state != ContactState::Slide || c.frozen || c.friction_cap.is_some() {
                 return;
             }
-            // Taken again, not from `du`: a locked contact whose spring `cap_shear` has just let
-            // go slides now, and its T_b is at its point, no longer at the spring's reference.
-            let du = c.relative_displacement(d, inp.blocks);
-            if law::reversed(&du, &c.rec.tau, c.slip_tolerance(inp.params)) {
+            if law::reversed(&c.du, &c.rec.tau, c.slip_tolerance(inp.params)) {
                 c.friction_cap = Some(c.rec.lambda);
             }
         });
