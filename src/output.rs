@@ -263,22 +263,27 @@ impl RowWriter {
 }
 
 /// When the outputs of a run are due: its first state, then every later step, or with an
-/// interval the first step at or past each multiple of it (see [`interval_slot`]). The final
-/// state is written apart, whatever the schedule.
+/// interval the first step at or past each multiple of it (see [`interval_slot`]); and its
+/// final state, whatever the schedule, unless it was the last output.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(crate) struct Schedule {
     /// Simulated time between outputs, s (`None`: every step).
     interval: Option<f64>,
+    /// Time of the last output.
+    last: Option<f64>,
 }
 
 impl Schedule {
     pub(crate) fn new(interval: Option<f64>) -> Self {
-        Schedule { interval }
+        Schedule {
+            interval,
+            last: None,
+        }
     }
 
-    /// Whether a state at `time` is written, the last one having been at `last`.
-    pub(crate) fn due(&self, time: f64, last: Option<f64>) -> bool {
-        let Some(last) = last else {
+    /// Whether a state at `time` is written.
+    pub(crate) fn due(&self, time: f64) -> bool {
+        let Some(last) = self.last else {
             return true;
         };
         match self.interval {
@@ -288,6 +293,16 @@ impl Schedule {
             // counts as reaching it.
             Some(dt) => interval_slot(time, dt) > interval_slot(last, dt),
         }
+    }
+
+    /// Whether the final state, at `time`, still has to be written.
+    pub(crate) fn final_due(&self, time: f64) -> bool {
+        self.last != Some(time)
+    }
+
+    /// Notes an output of the state at `time`.
+    pub(crate) fn wrote(&mut self, time: f64) {
+        self.last = Some(time);
     }
 }
 

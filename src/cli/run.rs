@@ -195,8 +195,6 @@ pub(super) struct Record {
     vtk: Option<VtkWriter>,
     /// When the CSV rows are written (every step without an interval).
     rows: Schedule,
-    /// The time of the last state whose rows were handed to the writer.
-    last_rows: Option<f64>,
     scene: String,
     method: Method,
     mode: Mode,
@@ -229,7 +227,6 @@ impl Record {
             writer,
             vtk,
             rows: Schedule::new(output.interval),
-            last_rows: None,
             scene: scene.to_string(),
             rock_masses,
             method: solver.params.method,
@@ -278,14 +275,14 @@ impl Record {
 
     /// Whether a state at `time` is written: its rows, or its VTK files.
     fn due(&self, time: f64) -> bool {
-        self.rows.due(time, self.last_rows) || self.vtk.as_ref().is_some_and(|v| v.due(time))
+        self.rows.due(time) || self.vtk.as_ref().is_some_and(|v| v.due(time))
     }
 
     /// The rows of a state and its VTK files, each when due.
     pub(super) fn write(&mut self, s: &Snapshot) -> Result<(), OutputError> {
-        if self.rows.due(s.time, self.last_rows) {
+        if self.rows.due(s.time) {
             self.writer.write(s)?;
-            self.last_rows = Some(s.time);
+            self.rows.wrote(s.time);
         }
         match &mut self.vtk {
             Some(vtk) => vtk.step(s),
@@ -311,9 +308,10 @@ impl Record {
         if !matches!(end, End::Io(_)) {
             // The state the run ended in is always written, whatever the interval.
             let s = solver.snapshot();
-            let rows = match self.last_rows {
-                Some(t) if t == s.time => Ok(()),
-                _ => self.writer.write(&s),
+            let rows = if self.rows.final_due(s.time) {
+                self.writer.write(&s)
+            } else {
+                Ok(())
             };
             let last = self.vtk.as_mut().map(|v| v.finish(&s));
             if let Err(e) = rows

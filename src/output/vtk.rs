@@ -63,7 +63,7 @@ impl VtkWriter {
 
     /// Writes the final state unless it was the last output.
     pub fn finish(&mut self, s: &Snapshot) -> Result<(), OutputError> {
-        if self.outputs.last().is_none_or(|o| o.0 != s.time) {
+        if self.schedule.final_due(s.time) {
             self.write(s)?;
         }
         Ok(())
@@ -72,7 +72,7 @@ impl VtkWriter {
     /// Whether a state at `time` is written: the first state, then the first step at or past
     /// each multiple of the interval (every step without one).
     pub fn due(&self, time: f64) -> bool {
-        self.schedule.due(time, self.outputs.last().map(|o| o.0))
+        self.schedule.due(time)
     }
 
     fn write(&mut self, s: &Snapshot) -> Result<(), OutputError> {
@@ -82,6 +82,7 @@ impl VtkWriter {
         self.put(&blocks, &blocks_vtu(s))?;
         self.put(&contacts, &contacts_vtp(s))?;
         self.outputs.push((s.time, blocks, contacts));
+        self.schedule.wrote(s.time);
         let series = |pick: fn(&(f64, String, String)) -> &str| {
             collection(self.outputs.iter().map(|o| (o.0, pick(o))))
         };
