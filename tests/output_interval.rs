@@ -155,12 +155,12 @@ fn a_run_resumed_with_an_interval_writes_the_uninterrupted_runs_rows() {
     let mut args = vec!["--resume", ckpt.to_str().unwrap()];
     args.extend(flags);
     run(&args, &resumed);
+    // The resumed run starts with the checkpoint's state; after it, the same steps.
+    let t1: f64 = rows_by_time(&resumed, "blocks.csv").2[0].parse().unwrap();
+    assert!(t1 > 0.7, "resumed at {t1}");
     for file in ["blocks.csv", "contacts.csv"] {
         let (_, a, order_full) = rows_by_time(&full, file);
         let (_, b, order) = rows_by_time(&resumed, file);
-        // The resumed run starts with the checkpoint's state; after it, the same steps.
-        let t1: f64 = rows_by_time(&resumed, "blocks.csv").2[0].parse().unwrap();
-        assert!(t1 > 0.7, "resumed at {t1}");
         let after = |o: &[String]| -> Vec<String> {
             o.iter()
                 .filter(|t| t.parse::<f64>().unwrap() > t1)
