@@ -14,6 +14,7 @@
 //! report).
 
 mod capture;
+mod frame_cache;
 mod sim_link;
 mod surface;
 mod timing;
@@ -33,6 +34,7 @@ use super::state::{Action, UiState};
 use super::{ViewerError, ViewerOptions};
 use crate::render::Gpu;
 use capture::{Capture, WindowCapture};
+use frame_cache::{FrameCache, FrameInputs};
 use sim_link::SimLink;
 use surface::{Acquired, EguiLayer, WindowSurface, is_software};
 use timing::{FrameClock, Timing};
@@ -158,7 +160,10 @@ enum Flow {
 
 /// What egui produced for one frame, ready to paint.
 struct UiFrame {
-    primitives: Vec<egui::ClippedPrimitive>,
+    /// egui's shapes, tessellated only when the frame is drawn anew.
+    shapes: Vec<egui::epaint::ClippedShape>,
+    /// egui set or replaced a texture this frame.
+    textures_changed: bool,
     pixels_per_point: f32,
     /// Textures egui no longer needs, freed once the frame is drawn or skipped.
     free: Vec<egui::TextureId>,
@@ -185,6 +190,8 @@ struct Viewer {
     ui: UiState,
     capture: Capture,
     clock: FrameClock,
+    /// The last composed picture, on software rasterizers (see `frame_cache.rs`).
+    frame_cache: Option<FrameCache>,
     /// The scene as loaded and the event loop's waker: a comparison started or ended from the
     /// panel restarts the simulation threads from them.
     scene: crate::scene::Scene,
@@ -199,6 +206,8 @@ impl Viewer {
     ) -> Result<Viewer, ViewerError> {
         let (surface, gpu) = WindowSurface::open(el, &opts.scene.name, opts.size)?;
         let software = is_software(&gpu);
+        let copies = surface.config.usage.contains(wgpu::TextureUsages::COPY_DST);
+        let frame_cache = (software && copies).then(FrameCache::new);
         let mut egui = EguiLayer::new(&surface.window, &gpu, surface.render_format);
         // 4× MSAA costs about three times as much per frame on a software rasterizer, where
         // the window must stay interactive; real GPUs get it for free.
@@ -232,6 +241,7 @@ impl Viewer {
             ui,
             capture: Capture::new(opts.out_dir, opts.screenshot, proxy.clone()),
             clock: FrameClock::new(opts.exit_after_frames, software),
+            frame_cache,
             scene: opts.scene,
             proxy,
         })
@@ -259,7 +269,7 @@ impl Viewer {
         self.take_simulation_state();
         tm.mark("sim");
         // 2. UI.
-        let frame = self.run_ui();
+        let mut frame = self.run_ui();
         tm.mark("ui");
         // 3. The surface.
         let Some(surface_tex) = self.acquire(&frame)? else {
@@ -273,10 +283,17 @@ impl Viewer {
             .create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("dda3d viewer frame"),
             });
-        self.draw_view(&mut encoder, frame.pixels_per_point);
+        let view_redrawn = self.draw_view(&mut encoder, frame.pixels_per_point);
         tm.mark("3d");
-        // 5. egui into the surface (and into the capture texture for --screenshot).
-        let shot = self.draw_egui(&mut encoder, &surface_tex, &frame, &mut tm)?;
+        // 5. egui into the surface (and into the capture texture for --screenshot), or the last
+        // picture again where nothing in it changed.
+        let shot = self.draw_egui(
+            &mut encoder,
+            &surface_tex,
+            &mut frame,
+            view_redrawn,
+            &mut tm,
+        )?;
         self.present(encoder, surface_tex, &frame, &mut tm);
         self.clock.frame_drawn(self.ui.frame.as_deref());
         self.ui.perf.frame_done(started);
@@ -320,7 +337,7 @@ impl Viewer {
         // egui's texture updates (font atlas) apply even when this frame is not drawn, or
         // later frames would miss glyphs.
         let pixels_per_point = out.pixels_per_point;
-        let primitives = self.egui.ctx.tessellate(out.shapes, pixels_per_point);
+        let textures_changed = !out.textures_delta.set.is_empty();
         for (id, deltas) in &out.textures_delta.set {
             for delta in deltas {
                 self.egui
@@ -334,7 +351,8 @@ impl Viewer {
             .map(|v| v.repaint_delay)
             .unwrap_or(Duration::MAX);
         UiFrame {
-            primitives,
+            shapes: out.shapes,
+            textures_changed,
             pixels_per_point,
             free: out.textures_delta.free.iter().copied().collect(),
             repaint_delay,
@@ -423,41 +441,50 @@ impl Viewer {
     }
 
     /// Step 4: fits the view texture to the view's rectangle and draws the scene into it.
-    fn draw_view(&mut self, encoder: &mut wgpu::CommandEncoder, pixels_per_point: f32) {
-        self.draw_view_b(encoder, pixels_per_point);
+    /// Returns whether a view was drawn anew (else the textures hold last frame's pictures).
+    fn draw_view(&mut self, encoder: &mut wgpu::CommandEncoder, pixels_per_point: f32) -> bool {
+        let redrawn_b = self.draw_view_b(encoder, pixels_per_point);
         let (vw, vh) = pixels(self.ui.view_rect, pixels_per_point);
         self.view.resize(&self.gpu, &mut self.egui.painter, vw, vh);
         let Some(scene) = &self.ui.scene else {
-            return;
+            return redrawn_b;
         };
         let mut camera = self.ui.view.camera.clone();
         camera.aspect = vw as f32 / vh as f32;
         let drawn = self
             .view
             .draw(&self.gpu, encoder, scene, &camera, self.ui.scene_version);
-        if let Err(e) = drawn {
-            self.ui.error(format!("cannot draw this step: {e}"));
+        match drawn {
+            Ok(redrawn) => redrawn || redrawn_b,
+            Err(e) => {
+                self.ui.error(format!("cannot draw this step: {e}"));
+                true
+            }
         }
     }
 
     /// Step 4 for run B of a comparison: its pane, with the same camera as A's.
-    fn draw_view_b(&mut self, encoder: &mut wgpu::CommandEncoder, pixels_per_point: f32) {
+    fn draw_view_b(&mut self, encoder: &mut wgpu::CommandEncoder, pixels_per_point: f32) -> bool {
         let (Some(view), Some(c)) = (self.view_b.as_mut(), self.ui.compare.as_deref()) else {
-            return;
+            return false;
         };
         if c.ghost {
-            return; // B is drawn by egui over A's pane
+            return false; // B is drawn by egui over A's pane
         }
         let (vw, vh) = pixels(c.view_rect_b, pixels_per_point);
         view.resize(&self.gpu, &mut self.egui.painter, vw, vh);
         let Some(scene) = &c.scene_b else {
-            return;
+            return false;
         };
         let mut camera = self.ui.view.camera.clone();
         camera.aspect = vw as f32 / vh as f32;
         let drawn = view.draw(&self.gpu, encoder, scene, &camera, c.scene_b_version);
-        if let Err(e) = drawn {
-            self.ui.error(format!("cannot draw this step of B: {e}"));
+        match drawn {
+            Ok(redrawn) => redrawn,
+            Err(e) => {
+                self.ui.error(format!("cannot draw this step of B: {e}"));
+                true
+            }
         }
     }
 
@@ -467,28 +494,57 @@ impl Viewer {
         &mut self,
         encoder: &mut wgpu::CommandEncoder,
         surface_tex: &wgpu::SurfaceTexture,
-        frame: &UiFrame,
+        frame: &mut UiFrame,
+        view_redrawn: bool,
         tm: &mut Timing,
     ) -> Result<Option<WindowCapture>, ViewerError> {
         let size = (surface_tex.texture.width(), surface_tex.texture.height());
         let capture_now = self.clock.drawing_last_frame();
+        let inputs = FrameInputs {
+            shapes: &frame.shapes,
+            pixels_per_point: frame.pixels_per_point,
+            size,
+            textures_changed: frame.textures_changed,
+            view_redrawn,
+        };
+        if let Some(cache) = &self.frame_cache
+            && !capture_now
+            && cache.unchanged(&inputs)
+        {
+            cache.copy_to(encoder, &surface_tex.texture);
+            tm.mark("copy");
+            return Ok(None);
+        }
         let screen = Screen {
             size_in_pixels: [size.0, size.1],
             pixels_per_point: frame.pixels_per_point,
         };
+        let shapes = if self.frame_cache.is_some() {
+            frame.shapes.clone()
+        } else {
+            std::mem::take(&mut frame.shapes)
+        };
+        let primitives = self.egui.ctx.tessellate(shapes, frame.pixels_per_point);
         tm.mark("tess");
         self.egui
             .painter
-            .prepare(&self.gpu.device, &self.gpu.queue, &frame.primitives, screen);
+            .prepare(&self.gpu.device, &self.gpu.queue, &primitives, screen);
         tm.mark("upd");
         let format = self.surface.render_format;
-        let surface_view = surface_tex
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor {
-                format: Some(format),
-                ..Default::default()
-            });
-        self.egui.paint(encoder, &surface_view);
+        if let Some(cache) = &mut self.frame_cache {
+            let target = cache.target(&self.gpu, (self.surface.config.format, format), size);
+            self.egui.paint(encoder, target);
+            cache.copy_to(encoder, &surface_tex.texture);
+            cache.keep(std::mem::take(&mut frame.shapes), frame.pixels_per_point);
+        } else {
+            let surface_view = surface_tex
+                .texture
+                .create_view(&wgpu::TextureViewDescriptor {
+                    format: Some(format),
+                    ..Default::default()
+                });
+            self.egui.paint(encoder, &surface_view);
+        }
         let shot = if capture_now {
             self.capture.window_shot(&self.gpu, format, size)?
         } else {

@@ -183,8 +183,15 @@ fn surface_config(
     format: wgpu::TextureFormat,
     render_format: wgpu::TextureFormat,
 ) -> wgpu::SurfaceConfiguration {
+    // On a software rasterizer the window's picture is composed in a texture and copied in
+    // (`frame_cache.rs`), where the surface allows it.
+    let copy = if is_software(gpu) && caps.usages.contains(wgpu::TextureUsages::COPY_DST) {
+        wgpu::TextureUsages::COPY_DST
+    } else {
+        wgpu::TextureUsages::empty()
+    };
     wgpu::SurfaceConfiguration {
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | copy,
         format,
         width: size.width.max(1),
         height: size.height.max(1),

@@ -74,7 +74,7 @@ impl ViewTarget {
     }
 
     /// Records the drawing of `scene` (at `version`) seen by `camera`, unless the texture
-    /// already holds that picture: it keeps its picture between frames.
+    /// already holds that picture: it keeps its picture between frames. Returns whether it drew.
     pub fn draw(
         &mut self,
         gpu: &Gpu,
@@ -82,16 +82,16 @@ impl ViewTarget {
         scene: &RenderScene,
         camera: &Camera,
         version: u64,
-    ) -> Result<(), RenderError> {
+    ) -> Result<bool, RenderError> {
         let (w, h) = self.size;
         let key = (version, camera.clone(), (w, h));
         if self.drawn.as_ref() == Some(&key) {
-            return Ok(());
+            return Ok(false);
         }
         self.renderer
             .prepare(&gpu.device, &gpu.queue, scene, camera, w, h)?;
         self.renderer.encode(encoder, &self.targets, &self.view);
         self.drawn = Some(key);
-        Ok(())
+        Ok(true)
     }
 }
