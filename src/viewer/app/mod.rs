@@ -6,12 +6,14 @@
 //! 3. acquire the window surface's texture;
 //! 4. draw the 3-D scene into the view's own texture (`Rgba8Unorm`, which egui can sample and
 //!    the renderer handles by encoding sRGB in its shader), sized to the view in pixels;
-//! 5. draw egui (panels and the view image) into the window surface, and present it;
+//! 5. draw egui (panels and the view image) into the window surface, and present it (on a
+//!    software rasterizer egui draws into a texture copied into the surface, and a frame that
+//!    would draw the same picture copies it again: `frame_cache.rs`);
 //! 6. decide when to draw again.
 //!
 //! The parts: `surface.rs` (the window, its surface, egui), `view_target.rs` (the 3-D view's
-//! texture), `capture.rs` (screenshots and recordings), `timing.rs` (pacing and the frame-time
-//! report).
+//! texture), `frame_cache.rs` (the last composed picture), `capture.rs` (screenshots and
+//! recordings), `timing.rs` (pacing and the frame-time report).
 
 mod capture;
 mod frame_cache;
