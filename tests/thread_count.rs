@@ -4,8 +4,9 @@
 //! CSV files of a run must not depend on how many threads the pool has.
 //!
 //! Runs each scene with 1, 2 and 3 threads (`RAYON_NUM_THREADS`) and compares blocks.csv and
-//! contacts.csv byte for byte: the rockfall (both methods), a struck wall of 60 blocks and a
-//! slice of the jointed slope (rock-mass cutting, joint sets, the equilibrium stage).
+//! contacts.csv byte for byte: the rockfall (both methods), a struck wall of 60 blocks, a
+//! slice of the jointed slope (rock-mass cutting, joint sets, the equilibrium stage) and a cube
+//! jointed in three dimensions, whose factorization runs on the pool.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -107,4 +108,50 @@ fn jointed_slope_slice_is_identical_with_any_thread_count() {
     )
     .unwrap();
     same_for_any_thread_count("slope", &slice, &["--duration", "0.1"]);
+}
+
+#[test]
+fn jointed_cube_is_identical_with_any_thread_count() {
+    // A 6 m cube cut every 1.2 m by three joint sets (about 125 blocks) on a fixed slab: its
+    // contact graph is three-dimensional, so the Cholesky fronts are about 600 rows high (the
+    // walls': 95), above the height from which faer factorizes on the whole pool
+    // (`physics::linear`). Two steps.
+    let dir = tmp("cube");
+    let cube = dir.join("cube.toml");
+    let mut text = String::from(
+        r#"name = "Jointed cube"
+
+[solver]
+method = "alm"
+duration = 0.02
+max_time_step = 0.01
+
+[joint]
+friction_angle = 40.0
+
+[materials.rock]
+density = 2600.0
+young_modulus = 1.0e10
+poisson_ratio = 0.25
+
+[[blocks]]
+name = "ground"
+material = "rock"
+fixed = true
+box = { size = [12, 12, 2], center = [3, 3, -1] }
+
+[[rock_masses]]
+name = "cube"
+material = "rock"
+regions = [ { prism = { base = [[0, 0, 0], [6, 0, 0], [6, 0, 6], [0, 0, 6]], extrude = [0, 6, 0] } } ]
+"#,
+    );
+    for (name, dip, dip_direction) in [("J1", 0.0, 0.0), ("J2", 80.0, 90.0), ("J3", 85.0, 0.0)] {
+        text.push_str(&format!(
+            "\n[[rock_masses.joint_sets]]\nname = \"{name}\"\ndip = {dip}\n\
+             dip_direction = {dip_direction}\nspacing = 1.2\n"
+        ));
+    }
+    std::fs::write(&cube, text).unwrap();
+    same_for_any_thread_count("cube", &cube, &[]);
 }
