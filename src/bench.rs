@@ -3,10 +3,12 @@
 //! figures measured on the 2-core CI machine.
 
 mod cutting;
+mod rock_masses;
 mod threads;
 mod walls;
 
 pub use cutting::cut_table;
+pub use rock_masses::rock_mass_table;
 pub use threads::thread_table;
 use walls::scaling_table;
 

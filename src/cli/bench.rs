@@ -1,5 +1,6 @@
 //! `dda3d bench`: checks the options and hands over to [`crate::bench`], which times the
-//! rockfall with both methods and the scaling on generated walls.
+//! rockfall with both methods, the scaling on generated walls, rock-mass cutting and, if asked,
+//! rock-mass scenes as they are.
 
 use std::path::PathBuf;
 
@@ -35,6 +36,10 @@ pub struct BenchArgs {
     /// separated, each 1..=100000).
     #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "1000,10000", allow_negative_numbers = true)]
     pub cut_sizes: Vec<usize>,
+    /// Rock-mass scenes timed as they are, their equilibrium stage apart (comma separated;
+    /// e.g. scenes/jointed_mass_1000.toml, about 8 minutes on two cores).
+    #[arg(long, value_delimiter = ',', num_args = 0..)]
+    pub rock_masses: Vec<PathBuf>,
 }
 
 /// The most runs per measurement: the best of 100 is as good as a minimum gets, and a bound
@@ -50,8 +55,18 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
             args.scene.display()
         )));
     }
-    // A scene that does not load is bad input (exit 2), not a failed benchmark.
+    // A scene that does not load is bad input (exit 2), not a failed benchmark; the rock masses
+    // are checked before anything runs.
     crate::scene::load(&args.scene).map_err(|e| CliError::Input(e.to_string()))?;
+    for path in &args.rock_masses {
+        if !path.exists() {
+            return Err(CliError::Input(format!(
+                "{}: no such scene file (--rock-masses)",
+                path.display()
+            )));
+        }
+        crate::scene::load(path).map_err(|e| CliError::Input(e.to_string()))?;
+    }
     crate::bench::run(
         &args.scene,
         &args.sizes,
@@ -66,6 +81,9 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
     }
     if !args.cut_sizes.is_empty() {
         crate::bench::cut_table(&args.cut_sizes, args.repeat).map_err(CliError::Run)?;
+    }
+    if !args.rock_masses.is_empty() {
+        crate::bench::rock_mass_table(&args.rock_masses).map_err(CliError::Run)?;
     }
     Ok(())
 }
