@@ -13,10 +13,11 @@
 use egui::epaint::ClippedShape;
 
 use crate::render::Gpu;
+use crate::render::offscreen::readable_target;
 
 /// The composed picture and what it was made of.
 pub(super) struct FrameCache {
-    /// The texture (the surface's format, viewable in egui's format).
+    /// The texture (egui's format) and a view of it.
     texture: Option<(wgpu::Texture, wgpu::TextureView)>,
     /// Its size in pixels.
     size: Option<(u32, u32)>,
@@ -59,34 +60,20 @@ impl FrameCache {
             && self.shapes == f.shapes
     }
 
-    /// The texture to draw this frame's egui pass into, `size` pixels in the surface's
-    /// `format`, seen through a view in egui's `render_format`. Invalid until [`Self::keep`].
+    /// The texture to draw this frame's egui pass into: `size` pixels in egui's `format`, a
+    /// target like the window capture's (its copy into the surface may add or drop the sRGB
+    /// encoding). Invalid until [`Self::keep`].
     pub fn target(
         &mut self,
         gpu: &Gpu,
-        (format, render_format): (wgpu::TextureFormat, wgpu::TextureFormat),
+        format: wgpu::TextureFormat,
         size: (u32, u32),
     ) -> &wgpu::TextureView {
         self.valid = false;
         if self.texture.is_none() || self.size != Some(size) {
-            let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-                label: Some("dda3d composed window"),
-                size: wgpu::Extent3d {
-                    width: size.0,
-                    height: size.1,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-                view_formats: &[render_format],
-            });
-            let view = texture.create_view(&wgpu::TextureViewDescriptor {
-                format: Some(render_format),
-                ..Default::default()
-            });
+            let texture =
+                readable_target(&gpu.device, "dda3d composed window", format, size.0, size.1);
+            let view = texture.create_view(&Default::default());
             self.texture = Some((texture, view));
             self.size = Some(size);
         }

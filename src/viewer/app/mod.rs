@@ -534,7 +534,7 @@ impl Viewer {
         tm.mark("upd");
         let format = self.surface.render_format;
         if let Some(cache) = &mut self.frame_cache {
-            let target = cache.target(&self.gpu, (self.surface.config.format, format), size);
+            let target = cache.target(&self.gpu, format, size);
             self.egui.paint(encoder, target);
             cache.copy_to(encoder, &surface_tex.texture);
             cache.keep(std::mem::take(&mut frame.shapes), frame.pixels_per_point);
