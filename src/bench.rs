@@ -86,6 +86,27 @@ fn generated_wall(n: usize, rock: bool, duration: f64) -> Result<Scene, String> 
     Ok(s)
 }
 
+/// A run's time per step of each stage, ms, as the tables print it: "detection / assembly /
+/// factorization / solve / bookkeeping".
+fn stage_split(t: &RunTotals) -> String {
+    let steps = t.steps.max(1) as f64;
+    let tm = &t.timings;
+    [
+        tm.detection,
+        tm.assembly,
+        tm.factorization,
+        tm.solve,
+        tm.bookkeeping,
+    ]
+    .map(|x| format!("{:.1}", 1e3 * x / steps))
+    .join(" / ")
+}
+
+/// A run's mean time per factorization, ms.
+fn ms_per_factorization(t: &RunTotals) -> f64 {
+    1e3 * t.timings.factorization / t.factorizations.max(1) as f64
+}
+
 /// Least-squares slope of log y against log x.
 pub fn growth_exponent(x: &[f64], y: &[f64]) -> f64 {
     let n = x.len() as f64;

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::walls::peak_rss_mb;
+use super::{ms_per_factorization, stage_split};
 use crate::scene;
 use crate::solver::Solver;
 
@@ -65,15 +66,13 @@ pub fn rock_mass_table(paths: &[PathBuf]) -> Result<(), String> {
         let r = time_rock_mass(path)?;
         let t = &r.totals;
         let steps = t.steps.max(1) as f64;
-        let tm = &t.timings;
-        let ms = |x: f64| format!("{:.1}", 1e3 * x / steps);
         let per_sim = if r.simulated > 0.0 {
             format!("{:.1}", r.wall / r.simulated)
         } else {
             "–".into()
         };
         println!(
-            "| {} | {} | {} | {:.1} | {} | {} | {:.3} | {:.1} | {per_sim} | {:.0} | {:.1} | {:.1} | {:.1} | {:.1} | {} / {} / {} / {} / {} | {} |",
+            "| {} | {} | {} | {:.1} | {} | {} | {:.3} | {:.1} | {per_sim} | {:.0} | {:.1} | {:.1} | {:.1} | {:.1} | {} | {} |",
             path.display(),
             r.blocks,
             r.stage_steps,
@@ -87,12 +86,8 @@ pub fn rock_mass_table(paths: &[PathBuf]) -> Result<(), String> {
             t.open_close_iterations as f64 / steps,
             t.alm_iterations as f64 / steps,
             t.factorizations as f64 / steps,
-            1e3 * tm.factorization / t.factorizations.max(1) as f64,
-            ms(tm.detection),
-            ms(tm.assembly),
-            ms(tm.factorization),
-            ms(tm.solve),
-            ms(tm.bookkeeping),
+            ms_per_factorization(t),
+            stage_split(t),
             peak_rss_mb().map_or("–".into(), |m| format!("{m:.0}")),
         );
     }

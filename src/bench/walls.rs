@@ -2,7 +2,7 @@
 //! counts, the wall time per simulated second, its split by stage, the cost of writing the
 //! output (apart), the peak memory and the growth exponents.
 
-use super::{best_of, generated_wall, growth_exponent};
+use super::{best_of, generated_wall, growth_exponent, ms_per_factorization, stage_split};
 
 /// One scaling table on generated walls, with or without the rockfall.
 pub(super) fn scaling_table(
@@ -37,10 +37,9 @@ pub(super) fn scaling_table(
         let t = &r.totals;
         let steps = t.steps.max(1) as f64;
         let contact_steps = t.contacts_per_step * t.steps as f64;
-        let tm = &t.timings;
         let ms = |x: f64| format!("{:.1}", 1e3 * x / steps);
         println!(
-            "| {n} | {} | {:.1} | {:.2} | {:.2} | {} | {:.3} | {:.3} | {:.1} | {:.2} | {:.3} | {} / {} / {} / {} / {} | {} | {} |",
+            "| {n} | {} | {:.1} | {:.2} | {:.2} | {} | {:.3} | {:.3} | {:.1} | {:.2} | {:.3} | {} | {} | {} |",
             t.steps,
             t.contacts_per_step,
             t.alm_iterations as f64 / steps,
@@ -50,12 +49,8 @@ pub(super) fn scaling_table(
             r.wall / r.simulated,
             steps / r.wall,
             1e6 * r.wall / contact_steps,
-            1e3 * tm.factorization / t.factorizations.max(1) as f64,
-            ms(tm.detection),
-            ms(tm.assembly),
-            ms(tm.factorization),
-            ms(tm.solve),
-            ms(tm.bookkeeping),
+            ms_per_factorization(t),
+            stage_split(t),
             r.output.map_or("–".into(), ms),
             peak_rss_mb().map_or("–".into(), |m| format!("{m:.0}")),
         );
