@@ -397,6 +397,13 @@ impl SparseCholesky {
 mod tests {
     use super::*;
 
+    fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+        a.iter()
+            .zip(b)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max)
+    }
+
     fn spd_block(seed: usize) -> Mat12 {
         let a = Mat12::from_fn(|r, c| ((r * 13 + c * 7 + seed * 3) % 11) as f64 / 11.0 - 0.5);
         a * a.transpose() + Mat12::identity() * 12.0
@@ -417,11 +424,7 @@ mod tests {
         let mut chol = SparseCholesky::default();
         chol.factorize(&k).unwrap();
         chol.solve_in_place(&mut b);
-        let err: f64 = b
-            .iter()
-            .zip(&x_true)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let err = max_abs_diff(&b, &x_true);
         assert!(err < 1e-12, "{err}");
         // Same pattern: no new symbolic analysis.
         k.diag[2] *= 2.0;
@@ -429,11 +432,7 @@ mod tests {
         assert_eq!(chol.symbolic_count, 1);
         let mut b = k.mul(&x_true);
         chol.solve_in_place(&mut b);
-        let err: f64 = b
-            .iter()
-            .zip(&x_true)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let err = max_abs_diff(&b, &x_true);
         assert!(err < 1e-12, "{err}");
     }
 
@@ -476,11 +475,7 @@ mod tests {
         assert!(chol.pair_slot.iter().any(|s| s.transposed));
         assert!(chol.pair_slot.iter().any(|s| !s.transposed));
         chol.solve_in_place(&mut b);
-        let err = b
-            .iter()
-            .zip(&x_true)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let err = max_abs_diff(&b, &x_true);
         assert!(err < 1e-11, "{err}");
     }
 
@@ -502,11 +497,6 @@ mod tests {
         let mut chol = SparseCholesky::default();
         assert!(chol.factorize(&k).is_err());
     }
-}
-
-#[cfg(test)]
-mod parallel_tests {
-    use super::*;
 
     /// A block graph whose every block touches every other: one front 12 n high.
     fn dense_graph(nb: usize) -> BlockMatrix {
@@ -545,11 +535,7 @@ mod parallel_tests {
         assert_eq!(t1, 1);
         // The solution is right (K x = b with b = sin i, so check K x).
         let kx = k.mul(&x1);
-        let res = kx
-            .iter()
-            .zip(&x_true)
-            .map(|(a, b)| (a - b).abs())
-            .fold(0.0, f64::max);
+        let res = max_abs_diff(&kx, &x_true);
         assert!(res < 1e-9, "{res}");
         for threads in [2, 3, 4] {
             let (t, l, x) = factor_and_solve(&k, threads);
