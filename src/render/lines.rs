@@ -64,11 +64,11 @@ impl LineRenderer {
             module: &module,
             vertex_entry: "vs_line",
             fragment_entry: "fs_line",
-            vertex_buffer: wgpu::VertexBufferLayout {
+            vertex_buffers: &[wgpu::VertexBufferLayout {
                 array_stride: std::mem::size_of::<LineInstance>() as u64,
                 step_mode: wgpu::VertexStepMode::Instance,
                 attributes: &ATTRIBUTES,
-            },
+            }],
             target,
             blend: None,
             depth: Some(DepthTest {

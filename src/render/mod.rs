@@ -2,21 +2,23 @@
 //! viewer so both draw the same picture. Depends on [`crate::snapshot`] alone.
 //!
 //! Rooms, bottom up:
-//! - [`camera`], [`mesh`], [`scene`]: CPU-side camera and geometry; [`scene`] turns a snapshot
-//!   into a [`RenderScene`] (unit-tested without a GPU);
+//! - [`camera`], [`mesh`], [`arrow_mesh`], [`scene`]: CPU-side camera and geometry (the
+//!   arrows as instances of one unit arrow); [`scene`] turns a snapshot into a [`RenderScene`]
+//!   (unit-tested without a GPU);
 //! - `gpu`: the [`Gpu`] handle (adapter/device/queue), opened apart from the drawing so a
 //!   window can bring its own;
 //! - `pipeline`, `buffer`: the wgpu set-up every pipeline shares, the window's egui painter
 //!   included (shader modules, bind groups, declared pipelines, growing buffers);
 //! - `renderer`: the 3-D pass ([`Renderer`]: 4× MSAA where supported, Depth32Float) over one
 //!   small renderer per primitive, each with its WGSL in `shaders/`: `solids` (block faces),
-//!   `arrows` (contact arrows, faint where hidden), `lines` (outlines and grid);
+//!   `arrows` (contact arrows, instanced, faint where hidden), `lines` (outlines and grid);
 //! - [`overlay`]: caption, legends and axis triad, painted with egui;
 //! - [`offscreen`]: an off-screen target with row-aligned readback;
 //! - [`capture`]: the pipelined PNG/GIF frame writer and single-frame screenshots.
 //!
 //! What the rest of the crate uses is re-exported below.
 
+pub mod arrow_mesh;
 mod arrows;
 pub(crate) mod buffer;
 pub mod camera;

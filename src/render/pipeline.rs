@@ -151,7 +151,7 @@ pub(crate) struct DepthTest {
     pub compare: wgpu::CompareFunction,
 }
 
-/// A render pipeline, declared: its shader entry points, one vertex buffer, the target, and
+/// A render pipeline, declared: its shader entry points, its vertex buffers, the target, and
 /// how it blends and depth-tests.
 pub(crate) struct PipelineSpec<'a> {
     pub label: &'a str,
@@ -159,7 +159,8 @@ pub(crate) struct PipelineSpec<'a> {
     pub module: &'a wgpu::ShaderModule,
     pub vertex_entry: &'a str,
     pub fragment_entry: &'a str,
-    pub vertex_buffer: wgpu::VertexBufferLayout<'a>,
+    /// Slot 0 first (an instanced pipeline: the template, then the instances).
+    pub vertex_buffers: &'a [wgpu::VertexBufferLayout<'a>],
     pub target: ColorTarget,
     /// `None` replaces the target's pixels.
     pub blend: Option<wgpu::BlendState>,
@@ -176,7 +177,12 @@ impl PipelineSpec<'_> {
                 module: self.module,
                 entry_point: Some(self.vertex_entry),
                 compilation_options: Default::default(),
-                buffers: &[Some(self.vertex_buffer.clone())],
+                buffers: &self
+                    .vertex_buffers
+                    .iter()
+                    .cloned()
+                    .map(Some)
+                    .collect::<Vec<_>>(),
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,

@@ -166,7 +166,8 @@ impl Renderer {
             &Globals::new(camera, width, height, self.encode_srgb),
         );
         self.solids.upload(device, queue, &scene.solids);
-        self.arrows.upload(device, queue, &scene.arrows);
+        self.arrows
+            .upload(device, queue, &scene.arrows, camera, height);
         self.lines.upload(device, queue, &scene.lines);
         let mut bg = scene.background();
         if self.encode_srgb > 0.5 {

@@ -4,10 +4,11 @@
 use glam::{DVec3, Vec3};
 
 use super::RenderError;
+use super::arrow_mesh::{Arrow, ArrowInstance};
 use super::camera::{Camera, CameraOverride};
 use super::mesh::{
-    self, Arrow, EDGE_SRGB, LOCK_SRGB, LineInstance, NORMAL_GLYPH_SRGB, OPEN_SRGB, Rgba,
-    SLIDE_SRGB, SolidVertex, hex, srgb_to_linear,
+    self, EDGE_SRGB, LOCK_SRGB, LineInstance, NORMAL_GLYPH_SRGB, OPEN_SRGB, Rgba, SLIDE_SRGB,
+    SolidVertex, hex, srgb_to_linear,
 };
 use crate::snapshot::{BlockSnapshot, ContactSnapshot, ContactState, Snapshot};
 
@@ -184,7 +185,7 @@ pub struct RenderScene {
     pub solids: Vec<SolidVertex>,
     /// Contact arrows — drawn depth-tested, then again faintly where hidden, so an arrow inside
     /// or behind a block still reads.
-    pub arrows: Vec<SolidVertex>,
+    pub arrows: Vec<ArrowInstance>,
     /// Outlines and grid.
     pub lines: Vec<LineInstance>,
     pub caption: Caption,
@@ -350,7 +351,7 @@ fn push_blocks(
 
 /// The contact part of a frame: its arrows and what the force legend prints.
 struct ContactArrows {
-    arrows: Vec<SolidVertex>,
+    arrows: Vec<ArrowInstance>,
     force_scale: Option<f64>,
     lock: usize,
     slide: usize,
@@ -435,7 +436,7 @@ fn state_color(state: ContactState) -> Rgba {
 
 /// The force on block i as an arrow from the contact point, `scale` N per metre.
 fn push_force_arrow(
-    arrows: &mut Vec<SolidVertex>,
+    arrows: &mut Vec<ArrowInstance>,
     c: &ContactSnapshot,
     base: Vec3,
     scale: f64,
@@ -450,13 +451,13 @@ fn push_force_arrow(
     // arrow at 40 % of the view so it does not cross the whole picture.
     let len = ((c.normal_force.abs() / scale) as f32).min(0.4 * scene_size as f32);
     let arrow = Arrow::new(base, dir, len, glyph.shaft);
-    mesh::push_arrow(arrows, &arrow, state_color(c.state));
+    arrows.extend(ArrowInstance::new(&arrow, state_color(c.state)));
 }
 
 /// A fixed-length glyph along the contact normal: thin and dark beside force arrows, in the
 /// contact's state colour on its own.
 fn push_normal_glyph(
-    arrows: &mut Vec<SolidVertex>,
+    arrows: &mut Vec<ArrowInstance>,
     c: &ContactSnapshot,
     base: Vec3,
     beside_forces: bool,
@@ -468,7 +469,10 @@ fn push_normal_glyph(
     } else {
         (glyph.shaft, state_color(c.state))
     };
-    mesh::push_arrow(arrows, &Arrow::new(base, n, glyph.normal_len, r), color);
+    arrows.extend(ArrowInstance::new(
+        &Arrow::new(base, n, glyph.normal_len, r),
+        color,
+    ));
 }
 
 /// Median bounding-box diagonal of the blocks (None without blocks).

@@ -37,7 +37,7 @@ pub(super) fn lit_pipeline(
         module,
         vertex_entry: "vs_solid",
         fragment_entry: "fs_solid",
-        vertex_buffer: solid_vertices(),
+        vertex_buffers: &[solid_vertices()],
         target,
         blend: None,
         depth: Some(DepthTest {

@@ -109,11 +109,11 @@ impl EguiPainter {
             module: &module,
             vertex_entry: "vs",
             fragment_entry: "fs",
-            vertex_buffer: wgpu::VertexBufferLayout {
+            vertex_buffers: &[wgpu::VertexBufferLayout {
                 array_stride: std::mem::size_of::<GpuVertex>() as u64,
                 step_mode: wgpu::VertexStepMode::Vertex,
                 attributes: &VERTEX_ATTRIBUTES,
-            },
+            }],
             target: ColorTarget { format, samples: 1 },
             blend: Some(BLEND),
             depth: None,

@@ -63,8 +63,7 @@ fn force_arrow_length_follows_scale() {
     assert_eq!(scene.force_scale, Some(2000.0));
     // 1000 N at 2000 N/m → 0.5 m arrow from the contact point along +z.
     let base = scene.to_local([0.0, 0.0, 1.0]);
-    let top = scene
-        .arrows
+    let top = triangles(&scene)
         .iter()
         .map(|v| v.position[2] - base.z)
         .fold(f32::MIN, f32::max);
@@ -72,8 +71,7 @@ fn force_arrow_length_follows_scale() {
     // A force far beyond the scale is capped at 40 % of the view.
     let big = snap(vec![contact(1e6, ContactState::Lock)]);
     let capped = RenderScene::build(&big, &style, &frame).unwrap();
-    let top_big = capped
-        .arrows
+    let top_big = triangles(&capped)
         .iter()
         .map(|v| v.position[2] - base.z)
         .fold(f32::MIN, f32::max);
@@ -164,8 +162,7 @@ fn arrows_stay_thin_next_to_small_blocks_in_a_big_scene() {
     let frame = SceneFrame::of_snapshot(&s);
     let scene = RenderScene::build(&s, &SceneStyle::default(), &frame).unwrap();
     let base = scene.to_local([0.0, 0.0, 1.0]);
-    let radius = scene
-        .arrows
+    let radius = triangles(&scene)
         .iter()
         .map(|v| {
             let r = glam::Vec3::from(v.position) - base;
@@ -219,7 +216,7 @@ fn arrow_limit_keeps_the_strongest_contacts() {
     assert_eq!(every.arrows_shown, None);
     let three = arrows(Some(3));
     assert_eq!(three.arrows_shown, Some(3));
-    // Same mesh size per arrow: three arrows are half of six.
+    // One instance per arrow: three arrows are half of six.
     assert_eq!(three.arrows.len() * 2, every.arrows.len());
     // The counts in the legend are of all contacts; the scale is the strongest one's.
     assert_eq!(three.contacts_lock, 6);
@@ -230,4 +227,9 @@ fn arrow_limit_keeps_the_strongest_contacts() {
     let f: Vec<f64> = kept.iter().map(|c| c.normal_force).collect();
     assert_eq!(f, vec![-500.0, 500.0, 40.0]);
     assert_eq!(arrows(Some(100)).arrows_shown, None);
+}
+
+/// The scene's arrows as the GPU draws them.
+fn triangles(scene: &RenderScene) -> Vec<crate::render::mesh::SolidVertex> {
+    scene.arrows.iter().flat_map(|a| a.triangles()).collect()
 }
