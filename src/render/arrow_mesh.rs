@@ -11,7 +11,15 @@
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
 
+use super::camera::Camera;
 use super::mesh::{Rgba, SolidVertex};
+
+/// Index into [`ARROW_LODS`] of the template the renderer draws `arrow` with, seen by
+/// `camera` on a target `height` pixels high.
+pub fn lod_seen(arrow: &ArrowInstance, camera: &Camera, height: u32) -> usize {
+    let px_per_unit = 0.5 * height as f32 / (0.5 * camera.fov_y).tan();
+    lod_for(arrow.radius_px(camera.eye(), px_per_unit))
+}
 
 /// An arrow: a cylindrical shaft from `base` along `dir`, then a cone whose apex is the tip at
 /// `base + dir * length`.

@@ -1,6 +1,6 @@
 //! Contact arrows: an indexed unit arrow drawn once per [`ArrowInstance`]
 //! (`vs_arrow` in shaders/arrow.wgsl), lit as the blocks are, with as many sides as its size on
-//! screen needs ([`lod_for`]: llvmpipe's time goes with the triangles). Drawn twice: once
+//! screen needs ([`lod_seen`]: llvmpipe's time goes with the triangles). Drawn twice: once
 //! depth-tested like the blocks and once, last of all, faintly where a block hides them, so an
 //! arrow inside or behind a block still reads (`fs_ghost` in shaders/solid.wgsl).
 
@@ -8,7 +8,7 @@ use std::mem::offset_of;
 
 use wgpu::util::DeviceExt;
 
-use super::arrow_mesh::{ARROW_LODS, ArrowInstance, ArrowTemplateVertex, arrow_template, lod_for};
+use super::arrow_mesh::{ARROW_LODS, ArrowInstance, ArrowTemplateVertex, arrow_template, lod_seen};
 use super::buffer::GrowBuffer;
 use super::camera::Camera;
 use super::pipeline::{ColorTarget, DepthTest, PipelineSpec, shader_module};
@@ -183,15 +183,11 @@ impl ArrowRenderer {
         camera: &Camera,
         height: u32,
     ) {
-        let px_per_unit = 0.5 * height as f32 / (0.5 * camera.fov_y).tan();
-        let eye = camera.eye();
         for lod in &mut self.lods {
             lod.chosen.clear();
         }
         for a in arrows {
-            self.lods[lod_for(a.radius_px(eye, px_per_unit))]
-                .chosen
-                .push(*a);
+            self.lods[lod_seen(a, camera, height)].chosen.push(*a);
         }
         for lod in &mut self.lods {
             lod.arrows.upload(device, queue, &lod.chosen);
