@@ -42,19 +42,6 @@ fn mean_shade_difference(a: &[u8], b: &[u8], overlay: &[u8]) -> f64 {
     sum / n.max(1) as f64
 }
 
-/// Pixels drawn (the arrows and the overlay's caption, legend and axes).
-fn drawn(img: &[u8]) -> usize {
-    img.chunks_exact(4)
-        .filter(|p| !is_background([p[0], p[1], p[2], p[3]]))
-        .count()
-}
-
-fn blue(img: &[u8]) -> usize {
-    img.chunks_exact(4)
-        .filter(|p| is_lock_blue([p[0], p[1], p[2], p[3]]))
-        .count()
-}
-
 #[test]
 fn instanced_arrows_draw_the_mirror_triangles() {
     let Some(gpu) = gpu_or_skip("instanced_arrows_draw_the_mirror_triangles") else {
@@ -100,9 +87,9 @@ fn instanced_arrows_draw_the_mirror_triangles() {
         let mut overlay_only = plain.clone();
         overlay_only.solids.clear();
         let overlay = off.render(&overlay_only, &camera).unwrap();
-        let arrow_pixels = drawn(&gpu_picture) - drawn(&overlay);
+        let arrow_pixels = drawn_pixels(&gpu_picture) - drawn_pixels(&overlay);
         assert!(
-            blue(&gpu_picture) > 0 && arrow_pixels > 100,
+            lock_blue_pixels(&gpu_picture) > 0 && arrow_pixels > 100,
             "arrows drawn at {distance}× the distance: {arrow_pixels} pixels"
         );
         // The same pixels covered: the shader places the template's vertices where the mirror

@@ -13,12 +13,6 @@ use render_support::*;
 const W: u32 = 1280;
 const H: u32 = 720;
 
-fn blue(img: &[u8]) -> usize {
-    img.chunks_exact(4)
-        .filter(|p| is_lock_blue([p[0], p[1], p[2], p[3]]))
-        .count()
-}
-
 #[test]
 fn shipped_slope_scene_renders_through_the_solver() {
     let Some(gpu) = gpu_or_skip("shipped_slope_scene_renders_through_the_solver") else {
@@ -37,10 +31,7 @@ fn shipped_slope_scene_renders_through_the_solver() {
     let mut off = Offscreen::new(gpu, W, H).unwrap();
     let (rgba0, camera) = render_rgba(&mut off, &snap0, &opts).unwrap();
     assert_eq!(rgba0.len(), (W * H * 4) as usize, "requested size");
-    let non_bg = rgba0
-        .chunks_exact(4)
-        .filter(|p| !is_background([p[0], p[1], p[2], p[3]]))
-        .count();
+    let non_bg = drawn_pixels(&rgba0);
     assert!(
         non_bg > (W * H / 10) as usize,
         "not blank: {non_bg} drawn pixels"
@@ -85,7 +76,7 @@ fn shipped_slope_scene_renders_through_the_solver() {
     let snap1 = solver.snapshot();
     assert_eq!(snap1.contacts.len(), 4);
     let (rgba1, _) = render_rgba(&mut off, &snap1, &opts).unwrap();
-    let (with, without) = (blue(&rgba1), blue(&rgba0));
+    let (with, without) = (lock_blue_pixels(&rgba1), lock_blue_pixels(&rgba0));
     assert!(
         with > without + 200,
         "arrow pixels: {with} with contacts, {without} without"

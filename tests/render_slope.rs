@@ -85,12 +85,7 @@ fn slope_scene_renders_block_background_and_arrows() {
     let mut bare = snap.clone();
     bare.contacts.clear();
     let (rgba_bare, _) = render_rgba(&mut off, &bare, &opts).unwrap();
-    let blue = |img: &[u8]| {
-        img.chunks_exact(4)
-            .filter(|p| is_lock_blue([p[0], p[1], p[2], p[3]]))
-            .count()
-    };
-    let (with, without) = (blue(&rgba), blue(&rgba_bare));
+    let (with, without) = (lock_blue_pixels(&rgba), lock_blue_pixels(&rgba_bare));
     assert!(
         with > without + 200,
         "arrow pixels: {with} with contacts, {without} without"

@@ -211,6 +211,20 @@ pub fn is_lock_blue(px: [u8; 4]) -> bool {
     b > 120 && b > r + 60 && b > g + 25
 }
 
+/// Pixels of an RGBA picture in the blue of locked-contact arrows.
+pub fn lock_blue_pixels(img: &[u8]) -> usize {
+    img.chunks_exact(4)
+        .filter(|p| is_lock_blue([p[0], p[1], p[2], p[3]]))
+        .count()
+}
+
+/// Pixels of an RGBA picture that are not the background.
+pub fn drawn_pixels(img: &[u8]) -> usize {
+    img.chunks_exact(4)
+        .filter(|p| !is_background([p[0], p[1], p[2], p[3]]))
+        .count()
+}
+
 /// The light background colour, exactly (opaque).
 pub fn is_background(px: [u8; 4]) -> bool {
     let bg = dda3d::render::scene::BACKGROUND_SRGB;
