@@ -107,6 +107,7 @@ struct Lod {
 impl Lod {
     fn new(device: &wgpu::Device, sides: usize) -> Lod {
         let (vertices, indices) = arrow_template(sides);
+        let index_count = indices.len() as u32;
         Lod {
             template: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("dda3d arrow template"),
@@ -116,10 +117,10 @@ impl Lod {
             indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("dda3d arrow template indices"),
                 // Padded to a multiple of 4 bytes, as every buffer's size.
-                contents: bytemuck::cast_slice(&padded(indices.clone())),
+                contents: bytemuck::cast_slice(&padded(indices)),
                 usage: wgpu::BufferUsages::INDEX,
             }),
-            index_count: indices.len() as u32,
+            index_count,
             arrows: GrowBuffer::vertices("dda3d arrows"),
             chosen: Vec::new(),
         }

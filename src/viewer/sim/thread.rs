@@ -44,8 +44,8 @@ pub(super) fn start(
         .name("dda3d-sim".into())
         // The same priority as the window's: the solver is what the user came for. (It ran at
         // nice +10 until issue #15, so that the window never waited; on two cores with llvmpipe
-        // that left the struck wall of 1000 blocks 55–60 % of its headless speed, and 69 % at
-        // the same priority, with the window still at 39 frames/s.)
+        // that left the struck wall of 1000 blocks a median 54 % of its headless speed, and 65 %
+        // at the same priority, with the window still at 39 frames/s: README, issue #15.)
         .spawn(move || sim.run(rx))
 }
 
