@@ -215,13 +215,17 @@ pub struct Snapshot {
     pub joint_sets: Vec<String>,
 }
 
-/// Wall time spent in the phases of the solver.
+/// Wall time spent in the phases of the solver, s.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Timings {
+    /// Contact detection, the contact groups, and the step's predicted Δt (whose range queries
+    /// read the groups).
     pub detection: f64,
+    /// K and F, the ALM's per-contact updates and the open–close checks.
     pub assembly: f64,
     pub factorization: f64,
     pub solve: f64,
+    /// The checks of a solved attempt (displacement, penetration, energy) and the commit.
     pub bookkeeping: f64,
 }
 

@@ -2,8 +2,13 @@
 //! and adapted penalty, the reference point of its shear spring, its sliding direction, and what
 //! is left of its cohesion. The solver keeps one record per [`super::ContactKey`].
 
-use super::ContactState;
+use super::{ContactKey, ContactState};
 use crate::physics::geometry::Vec3;
+
+/// The records the solver keeps, by contact. Looked up several times per contact per step, so
+/// hashed with rustc's Fx hash, not SipHash; nothing depends on the map's order (a checkpoint
+/// sorts the records by key).
+pub type RecordMap = rustc_hash::FxHashMap<ContactKey, ContactRecord>;
 
 /// The history of one contact.
 #[derive(Clone, Copy, Debug)]

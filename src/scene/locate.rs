@@ -16,6 +16,35 @@ pub(super) fn line_of(text: &str, offset: usize) -> usize {
         + 1
 }
 
+/// The lines of a text, for the line of many offsets: a scene of 10 000 blocks asked
+/// [`line_of`] for each block's line, and each call counted the newlines from the start (1.5 s
+/// of its 2.7 s load).
+pub(super) struct LineIndex {
+    /// Byte offsets of the text's newlines, ascending.
+    newlines: Vec<usize>,
+    len: usize,
+}
+
+impl LineIndex {
+    pub fn new(text: &str) -> Self {
+        let newlines = text
+            .bytes()
+            .enumerate()
+            .filter_map(|(k, b)| (b == b'\n').then_some(k))
+            .collect();
+        LineIndex {
+            newlines,
+            len: text.len(),
+        }
+    }
+
+    /// The 1-based line of a byte offset, as [`line_of`] gives it.
+    pub fn line(&self, offset: usize) -> usize {
+        let end = offset.min(self.len);
+        self.newlines.partition_point(|&k| k < end) + 1
+    }
+}
+
 /// The line of the value of `path` (`["solver", "contact", "beta"]`), if the text sets it.
 pub(super) fn key_line(text: &str, path: &[&str]) -> Option<usize> {
     let doc = DeTable::parse(text).ok()?;
@@ -87,5 +116,10 @@ mod tests {
         );
         assert_eq!(line_of("a\nb\nc", 4), 3);
         assert_eq!(line_of("a", 99), 1);
+        let text = "a\nbb\n\nccc\n";
+        let index = LineIndex::new(text);
+        for offset in 0..text.len() + 3 {
+            assert_eq!(index.line(offset), line_of(text, offset), "offset {offset}");
+        }
     }
 }

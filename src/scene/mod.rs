@@ -36,7 +36,7 @@ use std::path::Path;
 
 use build::{build_block, check_material, check_overlaps};
 use format::SceneFile;
-use locate::{key_at, key_line, line_of};
+use locate::{LineIndex, key_at, key_line, line_of};
 
 pub use crate::rockmass::report::RockMassReport;
 pub use write::cut_scene;
@@ -426,8 +426,9 @@ fn hand_blocks(
 ) -> Result<(Vec<Block>, Vec<Option<usize>>), SceneError> {
     let mut blocks = Vec::with_capacity(file.blocks.len());
     let mut lines = Vec::with_capacity(file.blocks.len());
+    let index = LineIndex::new(text);
     for (k, spanned) in file.blocks.iter().enumerate() {
-        let line = Some(line_of(text, spanned.span().start));
+        let line = Some(index.line(spanned.span().start));
         let spec = spanned.get_ref();
         let name = spec.name.clone().unwrap_or_else(|| format!("block{k}"));
         let berr = |m: String| SceneError {

@@ -5,6 +5,7 @@
 use std::collections::HashMap;
 
 use rayon::prelude::*;
+use rustc_hash::FxHashMap;
 
 use super::active::Active;
 use super::counters::debug_log;
@@ -15,7 +16,7 @@ use crate::contact::groups::{Bounds, ContactGroups};
 use crate::contact::joint::joint_set;
 use crate::contact::kinematics::normal_kinematics;
 use crate::contact::law;
-use crate::contact::record::ContactRecord;
+use crate::contact::record::{ContactRecord, RecordMap};
 use crate::contact::{Candidate, ContactKey, ContactState, DetectionParams, Shape};
 use crate::model::Block;
 use crate::params::{Method, SolverParams};
@@ -26,7 +27,7 @@ use crate::physics::mechanics::displacement_matrix;
 pub(crate) struct ActivationInputs<'a> {
     pub params: &'a SolverParams,
     pub blocks: &'a [Block],
-    pub records: &'a HashMap<ContactKey, ContactRecord>,
+    pub records: &'a RecordMap,
     /// Each block's initial bounding box (its group's w0 is measured on those).
     pub initial_boxes: &'a [(Vec3, Vec3)],
     /// The step about to be taken (0 for the first) and its start time.
@@ -64,7 +65,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
         .collect();
     // Contact transfer: a vertex that slid onto an adjacent, almost coplanar face of the same
     // block keeps its history.
-    let mut by_vertex: HashMap<(u32, u32, u32), ContactKey> = HashMap::new();
+    let mut by_vertex: FxHashMap<(u32, u32, u32), ContactKey> = FxHashMap::default();
     for k in inp.records.keys() {
         if k.mode == 0 {
             by_vertex.insert((k.i, k.j, k.feature_i), *k);
@@ -88,7 +89,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
 /// One detected contact with its record and frozen kinematics; `w0` is its group's.
 fn activate_one(
     inp: &ActivationInputs,
-    by_vertex: &HashMap<(u32, u32, u32), ContactKey>,
+    by_vertex: &FxHashMap<(u32, u32, u32), ContactKey>,
     cand: Candidate,
     w0: f64,
 ) -> (Active, bool) {

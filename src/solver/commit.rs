@@ -2,14 +2,12 @@
 //! the next step and the closed ones are published; the blocks take their new velocities (3.2),
 //! stresses and strains, and their vertices move by the finite-rotation update (1.3).
 
-use std::collections::HashMap;
-
 use nalgebra::Vector6;
 use rayon::prelude::*;
 
 use super::active::Active;
 use super::{PAR_BLOCKS, PAR_CONTACTS};
-use crate::contact::record::ContactRecord;
+use crate::contact::record::{ContactRecord, RecordMap};
 use crate::contact::{ContactKey, ContactState};
 use crate::model::Block;
 use crate::params::{Method, SolverParams};
@@ -37,7 +35,7 @@ pub(crate) fn commit_contacts(
     p: &SolverParams,
     maps: &[StepMap],
     active: &[Active],
-) -> (HashMap<ContactKey, ContactRecord>, Vec<ContactSnapshot>) {
+) -> (RecordMap, Vec<ContactSnapshot>) {
     // Each contact's record and snapshot in parallel, gathered in the contacts' order.
     let committed: Vec<(ContactKey, ContactRecord, Option<ContactSnapshot>)> = active
         .par_iter()
@@ -45,7 +43,7 @@ pub(crate) fn commit_contacts(
         .map(|c| commit_contact(p, maps, c))
         .collect();
     let mut contacts = Vec::new();
-    let mut records = HashMap::with_capacity(active.len());
+    let mut records = RecordMap::with_capacity_and_hasher(active.len(), Default::default());
     for (key, rec, snap) in committed {
         contacts.extend(snap);
         records.insert(key, rec);

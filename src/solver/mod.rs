@@ -25,8 +25,6 @@ mod open_close;
 mod step_control;
 pub mod watchdog;
 
-use std::collections::HashMap;
-
 use activate::{ActivationInputs, activate};
 use active::Active;
 use attempt::{AttemptInputs, Solved, attempt};
@@ -34,9 +32,8 @@ use counters::{Counters, Stopwatch, debug_log};
 use step_control::Retry;
 use watchdog::{EnergyWatch, step_gain_limit};
 
-use crate::contact::ContactKey;
 use crate::contact::groups::{Bounds, ContactGroups};
-use crate::contact::record::ContactRecord;
+use crate::contact::record::RecordMap;
 use crate::model::Model;
 use crate::params::{Mode, SolverParams};
 use crate::physics::geometry::Vec3;
@@ -85,7 +82,7 @@ pub struct Solver {
     /// Each block's initial bounding box, on which the groups' w0 are measured.
     initial_boxes: Vec<(Vec3, Vec3)>,
     /// What each contact carries to the next step.
-    records: HashMap<ContactKey, ContactRecord>,
+    records: RecordMap,
     linear: LinearCache,
     /// Closed contacts after the last step.
     contacts: Vec<ContactSnapshot>,
@@ -130,7 +127,7 @@ impl Solver {
             step: 0,
             w0,
             initial_boxes,
-            records: HashMap::new(),
+            records: RecordMap::default(),
             linear: LinearCache::default(),
             contacts: Vec::new(),
             last,
@@ -323,9 +320,9 @@ impl Solver {
             }
         }
         let (mut active, mut kmat, groups) = self.detect();
+        let predicted = step_control::predict_dt(&self.params, &self.model.blocks, &groups);
         self.totals.timings.detection += watch.seconds();
 
-        let predicted = step_control::predict_dt(&self.params, &self.model.blocks, &groups);
         let base = self.dt.min(predicted);
         let first = step_control::first_attempt(base, room);
         let (solved, dt, cuts, factorizations) =
@@ -418,14 +415,16 @@ impl Solver {
                     if at_floor {
                         return Ok(solved);
                     }
-                    check_energy(
+                    let watch = Stopwatch::start();
+                    let checked = check_energy(
                         &self.params,
                         &self.model.blocks,
                         self.energy.as_ref(),
                         &scheme,
                         (&solved.d, dt),
-                    )?;
-                    Ok(solved)
+                    );
+                    counters.totals.timings.bookkeeping += watch.seconds();
+                    checked.map(|()| solved)
                 });
             match result {
                 Ok(solved) => {
