@@ -104,10 +104,6 @@ pub(crate) fn alm_loop(
 }
 
 /// One linear solve: K brought up to date and refactorized if it changed, F assembled, D = K⁻¹F.
-///
-/// F does not depend on K's factor, so it is assembled on the pool while K is factorized (a
-/// wall's factorization runs on one thread): the two phases' times then overlap, and their sum
-/// can exceed the step's.
 fn solve(
     inp: &AlmInputs,
     sys: &mut System,
@@ -115,34 +111,22 @@ fn solve(
     counters: &mut Counters,
     k_dirty: bool,
 ) -> Result<Vec<f64>, Retry> {
-    let assemble_f = || {
-        let watch = Stopwatch::start();
-        let f = load_vector(inp.params, inp.blocks, inp.f0, active);
-        (f, watch.elapsed())
-    };
-    let mut f = if k_dirty {
-        let watch = Stopwatch::start();
+    let watch = Stopwatch::start();
+    if k_dirty {
         sys.sync
             .update(sys.kmat, inp.k0, &inp.params.contact, inp.blocks, active);
-        counters.assembly += watch.elapsed();
-        let (chol, kmat) = (&mut *sys.chol, &*sys.kmat);
-        let factorize = || {
-            let watch = Stopwatch::start();
-            (chol.factorize(kmat), watch.seconds())
-        };
-        let ((f, f_time), (ok, k_time)) = rayon::join(assemble_f, factorize);
-        counters.assembly += f_time;
-        counters.totals.timings.factorization += k_time;
+    }
+    let mut f = load_vector(inp.params, inp.blocks, inp.f0, active);
+    counters.assembly += watch.elapsed();
+    if k_dirty {
+        let watch = Stopwatch::start();
+        let ok = sys.chol.factorize(sys.kmat);
+        counters.totals.timings.factorization += watch.seconds();
         counters.factorizations += 1;
         if ok.is_err() {
             return Err(Retry::NotFinite);
         }
-        f
-    } else {
-        let (f, f_time) = assemble_f();
-        counters.assembly += f_time;
-        f
-    };
+    }
     let watch = Stopwatch::start();
     sys.chol.solve_in_place(&mut f);
     counters.totals.timings.solve += watch.seconds();

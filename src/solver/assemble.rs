@@ -118,9 +118,7 @@ pub(crate) fn contact_stiffness(
     t
 }
 
-/// Adds (`sign` = 1) or removes (−1) the stiffness of contact `c` in the state `key` (as
-/// [`StiffnessSync::update`] does; the tests assemble K with it).
-#[cfg(test)]
+/// Adds (`sign` = 1) or removes (−1) the stiffness of contact `c` in the state `key`.
 pub(crate) fn apply_stiffness(
     kmat: &mut BlockMatrix,
     cp: &ContactParams,
@@ -129,20 +127,12 @@ pub(crate) fn apply_stiffness(
     key: &StiffnessKey,
     sign: f64,
 ) {
-    add_stiffness(kmat, c, &contact_stiffness(cp, blocks, c, key), sign);
-}
-
-/// Adds (`sign` = 1) or removes (−1) the stiffness `t` of contact `c`.
-fn add_stiffness(kmat: &mut BlockMatrix, c: &Active, t: &ContactStiffness, sign: f64) {
+    let t = contact_stiffness(cp, blocks, c, key);
     let (i, j) = c.blocks();
     kmat.diag[i] += t.k_ii * sign;
     kmat.diag[j] += t.k_jj * sign;
     kmat.add_off(c.pair, i, j, &(t.k_ij * sign));
 }
-
-/// Changed contacts whose stiffness [`StiffnessSync::update`] computes together on the pool
-/// before adding it to K (3.5 kB each: a chunk stays in cache).
-const SYNC_CHUNK: usize = 1024;
 
 /// The force terms of one closed contact in its current state: normal (P10), locked shear
 /// spring (P15)/(5.7), or sliding friction (P20).
@@ -225,35 +215,18 @@ impl StiffnessSync {
             }
             self.in_k = vec![None; active.len()];
         }
-        let changed: Vec<usize> = (0..active.len())
-            .filter(|&k| self.in_k[k] != active[k].stiffness_key())
-            .collect();
-        // The stiffnesses in parallel (at the start of a step every contact's: a tenth of a
-        // standing wall's step), added to K afterwards in the contacts' order, so that K does
-        // not depend on the thread count.
-        for chunk in changed.chunks(SYNC_CHUNK) {
-            let terms: Vec<_> = chunk
-                .par_iter()
-                .with_min_len(PAR_CONTACTS / 32)
-                .map(|&k| {
-                    let c = &active[k];
-                    let old = self.in_k[k].map(|key| contact_stiffness(cp, blocks, c, &key));
-                    let new = c
-                        .stiffness_key()
-                        .map(|key| contact_stiffness(cp, blocks, c, &key));
-                    (old, new)
-                })
-                .collect();
-            for (&k, (old, new)) in chunk.iter().zip(terms) {
-                let c = &active[k];
-                if let Some(t) = old {
-                    add_stiffness(kmat, c, &t, -1.0);
-                }
-                if let Some(t) = new {
-                    add_stiffness(kmat, c, &t, 1.0);
-                }
-                self.in_k[k] = c.stiffness_key();
+        for (c, slot) in active.iter().zip(self.in_k.iter_mut()) {
+            let want = c.stiffness_key();
+            if *slot == want {
+                continue;
             }
+            if let Some(old) = slot {
+                apply_stiffness(kmat, cp, blocks, c, old, -1.0);
+            }
+            if let Some(new) = &want {
+                apply_stiffness(kmat, cp, blocks, c, new, 1.0);
+            }
+            *slot = want;
         }
     }
 }
