@@ -84,6 +84,30 @@ pub struct ContactStiffness {
     pub k_jj: Mat12,
 }
 
+/// One of the three 12×12 blocks of a contact's stiffness. Each block is formed on its own, by
+/// the same operations whether one block or all three are asked for, so K assembled block by
+/// block (on the pool, `crate::solver::assemble`) is K assembled contact by contact to the bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StiffnessBlock {
+    /// K_ii, block i's own rows and columns.
+    Ii,
+    /// K_ij, block i's rows and block j's columns.
+    Ij,
+    /// K_jj.
+    Jj,
+}
+
+impl ContactStiffness {
+    /// The three blocks, each with which it is.
+    pub fn blocks_mut(&mut self) -> [(&mut Mat12, StiffnessBlock); 3] {
+        [
+            (&mut self.k_ii, StiffnessBlock::Ii),
+            (&mut self.k_ij, StiffnessBlock::Ij),
+            (&mut self.k_jj, StiffnessBlock::Jj),
+        ]
+    }
+}
+
 /// Force contributions of one contact to the blocks i and j.
 #[derive(Clone, Debug, Default)]
 pub struct ContactForces {
@@ -93,9 +117,23 @@ pub struct ContactForces {
 
 /// Normal stiffness of a closed contact, (P10a)–(P10d).
 pub fn add_normal_stiffness(t: &mut ContactStiffness, k: &NormalKinematics, penalty: f64) {
-    t.k_ii += k.g_i * k.g_i.transpose() * penalty;
-    t.k_ij += k.g_i * k.g_j.transpose() * penalty;
-    t.k_jj += k.g_j * k.g_j.transpose() * penalty;
+    for (m, which) in t.blocks_mut() {
+        add_normal_stiffness_block(m, which, k, penalty);
+    }
+}
+
+/// The block `which` of [`add_normal_stiffness`].
+pub fn add_normal_stiffness_block(
+    m: &mut Mat12,
+    which: StiffnessBlock,
+    k: &NormalKinematics,
+    penalty: f64,
+) {
+    match which {
+        StiffnessBlock::Ii => *m += k.g_i * k.g_i.transpose() * penalty,
+        StiffnessBlock::Ij => *m += k.g_i * k.g_j.transpose() * penalty,
+        StiffnessBlock::Jj => *m += k.g_j * k.g_j.transpose() * penalty,
+    }
 }
 
 /// Normal force terms of a closed contact, (P10e)–(P10f): −(λ_{k−1} + p_n d0) G.
@@ -114,23 +152,39 @@ pub fn add_shear_spring_stiffness(
     n: &Vec3,
     p_tau: f64,
 ) {
-    let proj = nalgebra::Matrix3::identity() - n * n.transpose();
-    add_projected_stiffness(t, ta, tb, &proj, p_tau);
+    for (m, which) in t.blocks_mut() {
+        add_shear_spring_stiffness_block(m, which, ta, tb, n, p_tau);
+    }
 }
 
-/// The stiffness of a tangential spring `k` acting on the part `proj` of Δu_ab = T_a D_i − T_b D_j.
+/// The block `which` of [`add_shear_spring_stiffness`].
+pub fn add_shear_spring_stiffness_block(
+    m: &mut Mat12,
+    which: StiffnessBlock,
+    ta: &Mat3x12,
+    tb: &Mat3x12,
+    n: &Vec3,
+    p_tau: f64,
+) {
+    let proj = nalgebra::Matrix3::identity() - n * n.transpose();
+    add_projected_stiffness(m, which, ta, tb, &proj, p_tau);
+}
+
+/// The block `which` of the stiffness of a tangential spring `k` acting on the part `proj` of
+/// Δu_ab = T_a D_i − T_b D_j.
 fn add_projected_stiffness(
-    t: &mut ContactStiffness,
+    m: &mut Mat12,
+    which: StiffnessBlock,
     ta: &Mat3x12,
     tb: &Mat3x12,
     proj: &nalgebra::Matrix3<f64>,
     k: f64,
 ) {
-    let nta = proj * ta;
-    let ntb = proj * tb;
-    t.k_ii += ta.transpose() * nta * k;
-    t.k_ij -= ta.transpose() * ntb * k;
-    t.k_jj += tb.transpose() * ntb * k;
+    match which {
+        StiffnessBlock::Ii => *m += ta.transpose() * (proj * ta) * k,
+        StiffnessBlock::Ij => *m -= ta.transpose() * (proj * tb) * k,
+        StiffnessBlock::Jj => *m += tb.transpose() * (proj * tb) * k,
+    }
 }
 
 /// The tangent stiffness of sliding friction's direction. Friction of magnitude F along the slip
@@ -149,8 +203,23 @@ pub fn add_friction_tangent(
     tau: &Vec3,
     lateral: f64,
 ) {
+    for (m, which) in t.blocks_mut() {
+        add_friction_tangent_block(m, which, ta, tb, n, tau, lateral);
+    }
+}
+
+/// The block `which` of [`add_friction_tangent`].
+pub fn add_friction_tangent_block(
+    m: &mut Mat12,
+    which: StiffnessBlock,
+    ta: &Mat3x12,
+    tb: &Mat3x12,
+    n: &Vec3,
+    tau: &Vec3,
+    lateral: f64,
+) {
     let proj = nalgebra::Matrix3::identity() - n * n.transpose() - tau * tau.transpose();
-    add_projected_stiffness(t, ta, tb, &proj, lateral);
+    add_projected_stiffness(m, which, ta, tb, &proj, lateral);
 }
 
 /// The force of the tangential spring of [`add_shear_spring_stiffness`] at D = 0:
