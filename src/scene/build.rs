@@ -178,13 +178,8 @@ pub(super) fn check_overlaps(blocks: &[Block]) -> Result<(), (usize, String)> {
     let shapes: Vec<Shape> = blocks
         .iter()
         .map(|b| Shape {
-            vertices: &b.vertices,
-            topo: &b.topo,
-            face_normals: &b.face_normals,
-            centroid: b.mp.centroid,
-            lo: b.lo,
-            hi: b.hi,
             fixed: false,
+            ..Shape::of(b)
         })
         .collect();
     for (a, b) in broad_phase(&shapes, 0.0) {

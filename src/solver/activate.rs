@@ -10,7 +10,7 @@ use rustc_hash::FxHashMap;
 use super::active::Active;
 use super::counters::debug_log;
 use super::step_control::max_step_penetration;
-use super::{PAR_CONTACTS, PAR_PAIRS};
+use super::{PAR_BLOCKS, PAR_CONTACTS, PAR_PAIRS};
 use crate::contact::detection::detect_pair;
 use crate::contact::groups::{Bounds, ContactGroups};
 use crate::contact::joint::joint_set;
@@ -41,7 +41,12 @@ pub(crate) struct ActivationInputs<'a> {
 /// other (the broad phase's pairs, sorted).
 pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     let p = inp.params;
-    let shapes: Vec<Shape> = inp.blocks.iter().map(Shape::of).collect();
+    let shapes: Vec<Shape> = inp
+        .blocks
+        .par_iter()
+        .with_min_len(PAR_BLOCKS)
+        .map(Shape::of)
+        .collect();
     let bounds = inp
         .blocks
         .iter()

@@ -84,16 +84,7 @@ fn vertex_face(
 ) {
     let reach = Reach::around(b, p.search_distance);
     // Longest edge of each face of b, for the slack of the point-in-face test below.
-    let face_edges: Vec<f64> = b
-        .topo
-        .faces
-        .iter()
-        .map(|face| {
-            (0..face.len())
-                .map(|m| (b.vertices[face[(m + 1) % face.len()]] - b.vertices[face[m]]).norm())
-                .fold(0.0, f64::max)
-        })
-        .collect();
+    let face_edges = &b.edges.face_longest;
     for (vi, &pv) in a.vertices.iter().enumerate() {
         if !reach.holds(&pv, &pv) {
             continue;
@@ -103,7 +94,7 @@ fn vertex_face(
         // the widest slack a passing face allowed it.
         let mut outside = f64::NEG_INFINITY;
         let mut widest_slack = 0.0f64;
-        let vertex_edge = longest_edge_at(a, vi);
+        let vertex_edge = a.edges.vertex_longest[vi];
         for (fi, face) in b.topo.faces.iter().enumerate() {
             let n = b.face_normals[fi];
             let q0 = b.vertices[face[0]];
@@ -139,7 +130,7 @@ fn vertex_face(
             // slid past the edge of the face it lies on by a little more than that face's slack
             // allows, and only a far face of b still passed. See `face_beside`. (Without such a
             // face the claim stands: dropped, the vertex could sink into b unseen.)
-            if let Some(f) = face_beside(a, vi, b, (&face_edges, vertex_edge), outside, p) {
+            if let Some(f) = face_beside(a, vi, b, (face_edges, vertex_edge), outside, p) {
                 passing = vec![f];
             }
         }
@@ -187,17 +178,6 @@ fn face_beside(
     best.filter(|f| -f.gap <= DEPTH_RATIO * outside + p.tie_distance)
 }
 
-/// The longest edge of block `a` at its vertex `vi`, m.
-fn longest_edge_at(a: &Shape, vi: usize) -> f64 {
-    a.topo.vertex_edges[vi]
-        .iter()
-        .map(|&ei| {
-            let e = a.topo.edges[ei];
-            (a.vertices[e.v[1]] - a.vertices[e.v[0]]).norm()
-        })
-        .fold(0.0, f64::max)
-}
-
 /// The slack of the point-in-face test for a face whose longest edge is `face_edge` and a
 /// vertex whose longest edge is `vertex_edge`. It covers the blind spot the edge–edge test
 /// leaves near edge ends (closest points within ε_e of an end are refused there): a vertex a
@@ -223,11 +203,11 @@ fn faces_vertex(
     p: &DetectionParams,
 ) -> bool {
     let (face, n, pv) = (&b.topo.faces[fi], b.face_normals[fi], a.vertices[vi]);
-    let inside = (0..face.len()).all(|m| {
-        let qm = b.vertices[face[m]];
-        let e = b.vertices[face[(m + 1) % face.len()]] - qm;
-        (pv - qm).dot(&n.cross(&e.normalize())) >= -slack
-    });
+    let inward = b.edges.inward(fi, face.len());
+    let inside = face
+        .iter()
+        .zip(inward)
+        .all(|(&q, across)| (pv - b.vertices[q]).dot(across) >= -slack);
     inside
         && a.topo.vertex_edges[vi].iter().all(|&ei| {
             let e = a.topo.edges[ei];

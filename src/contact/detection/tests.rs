@@ -34,6 +34,7 @@ fn shape(o: &Owned) -> Shape<'_> {
         lo,
         hi,
         fixed: false,
+        edges: super::super::EdgeMeasures::of(&o.v, &o.t, &o.n),
     }
 }
 
@@ -291,14 +292,9 @@ fn a_vertex_just_past_a_face_edge_is_taken_on_the_face_that_separates_it() {
     let beside = |x: Vec3, outside: f64| {
         let a = tip(x);
         let vi = a.v.iter().position(|v| (v - x).norm() < 1e-12).unwrap();
-        face_beside(
-            &shape(&a),
-            vi,
-            &shape(&b),
-            (&faces, longest_edge_at(&shape(&a), vi)),
-            outside,
-            &p,
-        )
+        let sa = shape(&a);
+        let longest = sa.edges.vertex_longest[vi];
+        face_beside(&sa, vi, &shape(&b), (&faces, longest), outside, &p)
     };
     let f = beside(Vec3::new(0.5, -0.005, 1.003), 0.005).expect("the side face");
     assert!(
