@@ -158,7 +158,13 @@ impl SavedSolver {
             w0,
             initial_boxes,
             records,
-            linear: LinearCache { pattern, chol },
+            // K's storage is not state: every attempt sets its values afresh.
+            linear:
+                LinearCache {
+                    pattern,
+                    chol,
+                    matrix: _,
+                },
             contacts,
             last,
             totals,
@@ -246,6 +252,7 @@ impl SavedSolver {
             linear: LinearCache {
                 pattern: self.pattern,
                 chol,
+                matrix: None,
             },
             contacts: self.contacts,
             last: self.last,
