@@ -21,7 +21,6 @@ use crate::contact::{Candidate, ContactKey, ContactState, DetectionParams, Shape
 use crate::model::Block;
 use crate::params::{Method, SolverParams};
 use crate::physics::geometry::{Vec3, planar_hull_area};
-use crate::physics::mechanics::displacement_matrix;
 
 /// What activation reads.
 pub(crate) struct ActivationInputs<'a> {
@@ -157,12 +156,10 @@ fn activate_one(
     }
     let unseen = old.is_none_or(|r| r.state == ContactState::Open);
     keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen, w0);
-    let ta = displacement_matrix(&(cand.xa - bi.mp.centroid));
     let active = Active {
         joint: joint_set(&cand.key, bi, bj),
         kin,
         alt_kin,
-        ta,
         young: bi.material.young_modulus.min(bj.material.young_modulus),
         weight: lighter_weight(bi, bj, p),
         w0,

@@ -153,7 +153,7 @@ fn measure(p: &SolverParams, blocks: &[Block], d: &[f64], active: &mut [Active])
             }
             let alm = p.method == Method::Alm;
             if alm {
-                c.du = c.ta * di - c.tb(blocks) * dj;
+                c.du = c.ta(blocks) * di - c.tb(blocks) * dj;
             }
             let lambda = if alm { c.rec.lambda } else { 0.0 };
             c.force = lambda + c.rec.penalty * c.dn;

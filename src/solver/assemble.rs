@@ -111,10 +111,17 @@ pub(crate) fn contact_stiffness(
     if key.lock {
         let tb = c.tb_at(&key.reference, blocks);
         let p_tau = cp.shear_penalty(key.penalty);
-        add_shear_spring_stiffness(&mut t, &c.ta, &tb, &c.cand.normal, p_tau);
+        add_shear_spring_stiffness(&mut t, &c.ta(blocks), &tb, &c.cand.normal, p_tau);
     } else if key.lateral > 0.0 {
         let tb = c.tb_at(&c.cand.xb, blocks);
-        add_friction_tangent(&mut t, &c.ta, &tb, &c.cand.normal, &key.tau, key.lateral);
+        add_friction_tangent(
+            &mut t,
+            &c.ta(blocks),
+            &tb,
+            &c.cand.normal,
+            &key.tau,
+            key.lateral,
+        );
     }
     t
 }
@@ -132,11 +139,11 @@ fn contact_stiffness_block(
     if key.lock {
         let tb = c.tb_at(&key.reference, blocks);
         let p_tau = cp.shear_penalty(key.penalty);
-        add_shear_spring_stiffness_block(&mut m, which, &c.ta, &tb, &c.cand.normal, p_tau);
+        add_shear_spring_stiffness_block(&mut m, which, &c.ta(blocks), &tb, &c.cand.normal, p_tau);
     } else if key.lateral > 0.0 {
         let tb = c.tb_at(&c.cand.xb, blocks);
         let (n, tau) = (&c.cand.normal, &key.tau);
-        add_friction_tangent_block(&mut m, which, &c.ta, &tb, n, tau, key.lateral);
+        add_friction_tangent_block(&mut m, which, &c.ta(blocks), &tb, n, tau, key.lateral);
     }
     m
 }
@@ -173,10 +180,16 @@ pub(crate) fn contact_forces(p: &SolverParams, blocks: &[Block], c: &Active) -> 
         ContactState::Lock => {
             let delta = c.cand.xa - c.rec.reference;
             let p_tau = p.contact.shear_penalty(c.rec.penalty);
-            add_shear_spring_force(&mut t, &c.ta, &tb, &c.cand.normal, &delta, p_tau);
+            add_shear_spring_force(&mut t, &c.ta(blocks), &tb, &c.cand.normal, &delta, p_tau);
         }
         ContactState::Slide => {
-            add_friction(&mut t, &c.ta, &tb, &c.rec.tau, c.sliding_friction(p));
+            add_friction(
+                &mut t,
+                &c.ta(blocks),
+                &tb,
+                &c.rec.tau,
+                c.sliding_friction(p),
+            );
         }
         ContactState::Open => {}
     }
