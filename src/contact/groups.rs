@@ -59,21 +59,55 @@ pub fn search_distance(w0: f64, delta: f64) -> f64 {
 pub struct SweepIndex {
     axis: usize,
     order: Vec<usize>,
-    /// The blocks of `order` no longer along the axis than [`WIDE_RATIO`] times the median
-    /// block, in the same order, for [`SweepIndex::near`], and `lo[axis]` of each.
-    narrow: Vec<usize>,
-    starts: Vec<f64>,
-    /// The largest extent of a narrow box along the axis.
-    widest: f64,
-    /// The other blocks (a ground slab under a whole wall), tested one by one in `near`.
-    wide: Vec<usize>,
+    /// For [`SweepIndex::near`]: the blocks no longer along the axis than [`WIDE_RATIO`] times
+    /// the median block, and the others (a ground slab under a whole wall), each in sweep order.
+    narrow: SweepRange,
+    wide: SweepRange,
 }
 
-/// A box longer along the sweep axis than this many times the median box is kept out of the
-/// sorted range of [`SweepIndex::near`]. A range query must reach back by the longest box's
-/// extent: with a 248 m ground slab under a wall of 1.2 m blocks, every query scanned every block
-/// before it, and the step control's queries (one per block, twice a step) took 40 % of a step
-/// of a standing wall of 10 000 blocks.
+/// Blocks in sweep order, for range queries: `lo[axis]` of each, and the largest extent of
+/// their boxes along the axis (how far back a query must reach).
+struct SweepRange {
+    order: Vec<usize>,
+    starts: Vec<f64>,
+    widest: f64,
+}
+
+impl SweepRange {
+    fn of(boxes: &[Bounds], axis: usize, order: Vec<usize>) -> Self {
+        let starts = order.iter().map(|&k| boxes[k].lo[axis]).collect();
+        let widest = order
+            .iter()
+            .map(|&k| boxes[k].hi[axis] - boxes[k].lo[axis])
+            .fold(0.0, f64::max);
+        SweepRange {
+            order,
+            starts,
+            widest,
+        }
+    }
+
+    /// The blocks whose start on the axis lies within `max_reach` (and their own extent) of
+    /// box `b`: a superset of those whose boxes come within `max_reach` of it.
+    fn around(&self, b: &Bounds, axis: usize, max_reach: f64) -> &[usize] {
+        // A box that starts before this cannot reach `b`; the slack covers round-off.
+        let slack = 1e-9 * (b.lo[axis].abs() + self.widest + max_reach);
+        let from = self
+            .starts
+            .partition_point(|&s| s < b.lo[axis] - max_reach - self.widest - slack);
+        let to = self
+            .starts
+            .partition_point(|&s| s <= b.hi[axis] + max_reach);
+        &self.order[from..to.max(from)]
+    }
+}
+
+/// A box longer along the sweep axis than this many times the median box is kept in a range of
+/// its own for [`SweepIndex::near`]. A range query must reach back by the longest box's extent:
+/// with a 248 m ground slab under a wall of 1.2 m blocks, every query scanned every block before
+/// it, and the step control's queries (one per block, twice a step) took 40 % of a step of a
+/// standing wall of 10 000 blocks. Split so, neither range reaches back further than the one
+/// range did.
 const WIDE_RATIO: f64 = 8.0;
 
 impl SweepIndex {
@@ -100,15 +134,11 @@ impl SweepIndex {
         };
         let (narrow, wide): (Vec<usize>, Vec<usize>) =
             order.iter().partition(|&&k| extent(k) <= limit);
-        let starts = narrow.iter().map(|&k| boxes[k].lo[axis]).collect();
-        let widest = narrow.iter().map(|&k| extent(k)).fold(0.0, f64::max);
         SweepIndex {
             axis,
             order,
-            narrow,
-            starts,
-            widest,
-            wide,
+            narrow: SweepRange::of(boxes, axis, narrow),
+            wide: SweepRange::of(boxes, axis, wide),
         }
     }
 
@@ -156,17 +186,11 @@ impl SweepIndex {
         reach: impl Fn(usize) -> f64 + 's,
     ) -> impl Iterator<Item = usize> + 's {
         let b = &boxes[i];
-        // A box that starts before this cannot reach `b`; the slack covers round-off.
-        let slack = 1e-9 * (b.lo[self.axis].abs() + self.widest + max_reach);
-        let from = self
-            .starts
-            .partition_point(|&s| s < b.lo[self.axis] - max_reach - self.widest - slack);
-        let to = self
-            .starts
-            .partition_point(|&s| s <= b.hi[self.axis] + max_reach);
-        self.narrow[from..to]
+        let narrow = self.narrow.around(b, self.axis, max_reach);
+        let wide = self.wide.around(b, self.axis, max_reach);
+        narrow
             .iter()
-            .chain(&self.wide)
+            .chain(wide)
             .copied()
             .filter(move |&k| k != i && reaches(b, &boxes[k], reach(k)))
     }
@@ -489,7 +513,7 @@ mod tests {
             );
         }
         let index = SweepIndex::new(&boxes);
-        assert_eq!(index.wide.len(), 3);
+        assert_eq!(index.wide.order.len(), 3);
         for i in 0..boxes.len() {
             let reach = |k: usize| 0.1 * (k % 7) as f64;
             let mut fast: Vec<usize> = index.near(&boxes, i, 0.6, reach).collect();
