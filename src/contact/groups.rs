@@ -496,7 +496,7 @@ mod tests {
             })
             .collect();
         // Slabs far longer along the sweep axis (x) than the median box, among the others: the
-        // index keeps them out of its sorted range and tests them one by one.
+        // index keeps them in a sorted range of their own.
         for (k, &(x0, len)) in [(-3.0, 45.0), (5.0, 20.0), (12.0, 30.0)].iter().enumerate() {
             let (lo, hi) = (
                 Vec3::new(x0, 2.0 * k as f64, 1.0),

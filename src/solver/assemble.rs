@@ -222,6 +222,23 @@ pub(crate) fn load_vector(
     f
 }
 
+/// Takes contact `c`'s stiffness in the state `old` out of K and puts it in in its present
+/// state: one contact's part of [`StiffnessSync::update`].
+pub(crate) fn restate_stiffness(
+    kmat: &mut BlockMatrix,
+    cp: &ContactParams,
+    blocks: &[Block],
+    c: &Active,
+    old: Option<&StiffnessKey>,
+) {
+    if let Some(old) = old {
+        apply_stiffness(kmat, cp, blocks, c, old, -1.0);
+    }
+    if let Some(new) = &c.stiffness_key() {
+        apply_stiffness(kmat, cp, blocks, c, new, 1.0);
+    }
+}
+
 /// K kept in step with the contacts of an attempt. K is updated, not rebuilt: only the contacts
 /// whose state, penalty or shear-spring reference changed since the last assembly swap their old
 /// stiffness for the new one. Rebuilding all of them at every state change or penalty raise
@@ -258,13 +275,7 @@ impl StiffnessSync {
             update_by_block(kmat, cp, blocks, active, &self.in_k, &changed);
         } else {
             for &k in &changed {
-                let c = &active[k];
-                if let Some(old) = &self.in_k[k] {
-                    apply_stiffness(kmat, cp, blocks, c, old, -1.0);
-                }
-                if let Some(new) = &c.stiffness_key() {
-                    apply_stiffness(kmat, cp, blocks, c, new, 1.0);
-                }
+                restate_stiffness(kmat, cp, blocks, &active[k], self.in_k[k].as_ref());
             }
         }
         for &k in &changed {
@@ -379,13 +390,13 @@ mod tests {
 
     /// The rockfall column run into the impact (from 0.25 s on, to the first step where both
     /// vertex–face and edge–edge contacts are active): the solver, its contacts for the next
-    /// step, and their block pairs.
+    /// step (each pointing at its pair in a matrix laid out on the pairs), and their block pairs.
     fn at_impact() -> (Solver, Vec<Active>, Vec<(usize, usize)>) {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("scenes/rock_column_rockfall.toml");
         let s = crate::scene::load(&path).unwrap();
         let mut solver = Solver::new(s.model, s.params);
-        let active = loop {
+        let mut active = loop {
             solver.step().unwrap();
             let (active, _) = activate(&ActivationInputs {
                 params: &solver.params,
@@ -402,11 +413,29 @@ mod tests {
             }
             assert!(solver.time < 2.0, "no edge–edge contact by 2 s");
         };
-        let pairs = active
+        let pairs: Vec<_> = active
             .iter()
             .map(|c| (c.cand.key.i as usize, c.cand.key.j as usize))
             .collect();
+        let pattern = BlockMatrix::new(solver.model.blocks.len(), pairs.clone());
+        for c in &mut active {
+            c.pair = pattern
+                .pair_index(c.cand.key.i as usize, c.cand.key.j as usize)
+                .unwrap();
+        }
         (solver, active, pairs)
+    }
+
+    /// Changes every contact: opened, set sliding, stiffened ×1000, or its spring re-anchored.
+    fn change_every_contact(active: &mut [Active]) {
+        for (n, c) in active.iter_mut().enumerate() {
+            match n % 4 {
+                0 => c.rec.state = ContactState::Open,
+                1 => c.rec.state = ContactState::Slide,
+                2 => c.rec.penalty *= 1000.0,
+                _ => c.rec.reference += Vec3::new(1e-3, -2e-3, 5e-4),
+            }
+        }
     }
 
     /// K assembled afresh for a step of 0.01 s: the block terms and every closed contact.
@@ -441,9 +470,6 @@ mod tests {
         let mut k = BlockMatrix::new(solver.model.blocks.len(), pairs);
         // Alternate the states so that both closed variants are assembled; raise some penalties.
         for (n, c) in active.iter_mut().enumerate() {
-            c.pair = k
-                .pair_index(c.cand.key.i as usize, c.cand.key.j as usize)
-                .unwrap();
             c.rec.state = if n % 2 == 0 {
                 ContactState::Lock
             } else {
@@ -494,11 +520,7 @@ mod tests {
     fn block_by_block_update_is_the_contact_by_contact_update_to_the_bit() {
         let (solver, mut active, pairs) = at_impact();
         let (cp, blocks) = (&solver.params.contact, &solver.model.blocks);
-        let pattern = BlockMatrix::new(blocks.len(), pairs.clone());
         for (n, c) in active.iter_mut().enumerate() {
-            c.pair = pattern
-                .pair_index(c.cand.key.i as usize, c.cand.key.j as usize)
-                .unwrap();
             c.rec.state = if n % 2 == 0 {
                 ContactState::Lock
             } else {
@@ -511,12 +533,7 @@ mod tests {
         let none = vec![None; active.len()];
         let serial = |from: &[Option<StiffnessKey>], to: &[Active], k: &mut BlockMatrix| {
             for (c, old) in to.iter().zip(from) {
-                if let Some(old) = old {
-                    apply_stiffness(k, cp, blocks, c, old, -1.0);
-                }
-                if let Some(new) = &c.stiffness_key() {
-                    apply_stiffness(k, cp, blocks, c, new, 1.0);
-                }
+                restate_stiffness(k, cp, blocks, c, old.as_ref());
             }
         };
         let pools: Vec<_> = (1..=3)
@@ -535,14 +552,7 @@ mod tests {
             pool.install(|| update_by_block(k, cp, blocks, &active, &none, &all));
         }
         let first: Vec<_> = active.iter().map(|c| c.stiffness_key()).collect();
-        for (n, c) in active.iter_mut().enumerate() {
-            match n % 4 {
-                0 => c.rec.state = ContactState::Open,
-                1 => c.rec.state = ContactState::Slide,
-                2 => c.rec.penalty *= 1000.0,
-                _ => c.rec.reference += Vec3::new(1e-3, -2e-3, 5e-4),
-            }
-        }
+        change_every_contact(&mut active);
         serial(&first, &active, &mut want);
         for (threads, (pool, k)) in pools.iter().zip(&mut got).enumerate() {
             pool.install(|| update_by_block(k, cp, blocks, &active, &first, &all));
@@ -562,47 +572,16 @@ mod tests {
             assemble_fresh(&solver, active, &mut k);
             k
         };
-        let pattern = BlockMatrix::new(solver.model.blocks.len(), pairs.clone());
         for c in active.iter_mut() {
-            c.pair = pattern
-                .pair_index(c.cand.key.i as usize, c.cand.key.j as usize)
-                .unwrap();
             c.rec.state = ContactState::Lock;
         }
         let mut k = fresh(&active);
         let keys: Vec<_> = active.iter().map(|c| c.stiffness_key()).collect();
-        // Every contact changes: opened, set sliding, stiffened ×1000, or its spring re-anchored.
-        for (n, c) in active.iter_mut().enumerate() {
-            match n % 4 {
-                0 => c.rec.state = ContactState::Open,
-                1 => c.rec.state = ContactState::Slide,
-                2 => c.rec.penalty *= 1000.0,
-                _ => c.rec.reference += Vec3::new(1e-3, -2e-3, 5e-4),
-            }
-        }
+        change_every_contact(&mut active);
         for (c, old) in active.iter().zip(&keys) {
-            let new = c.stiffness_key();
-            assert_ne!(&new, old);
-            if let Some(old) = old {
-                apply_stiffness(
-                    &mut k,
-                    &solver.params.contact,
-                    &solver.model.blocks,
-                    c,
-                    old,
-                    -1.0,
-                );
-            }
-            if let Some(new) = &new {
-                apply_stiffness(
-                    &mut k,
-                    &solver.params.contact,
-                    &solver.model.blocks,
-                    c,
-                    new,
-                    1.0,
-                );
-            }
+            assert_ne!(&c.stiffness_key(), old);
+            let (cp, blocks) = (&solver.params.contact, &solver.model.blocks);
+            restate_stiffness(&mut k, cp, blocks, c, old.as_ref());
         }
         let want = fresh(&active);
         let scale = want

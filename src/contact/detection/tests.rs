@@ -34,7 +34,7 @@ fn shape(o: &Owned) -> Shape<'_> {
         lo,
         hi,
         fixed: false,
-        edges: super::super::EdgeMeasures::of(&o.v, &o.t, &o.n),
+        edges: crate::contact::EdgeMeasures::of(&o.v, &o.t, &o.n),
     }
 }
 
