@@ -3,11 +3,13 @@
 //! figures measured on the 2-core CI machine.
 
 mod cutting;
+mod methods;
 mod rock_masses;
 mod threads;
 mod walls;
 
 pub use cutting::cut_table;
+pub use methods::method_table;
 pub use rock_masses::rock_mass_table;
 pub use threads::thread_table;
 use walls::scaling_table;
@@ -102,6 +104,14 @@ fn stage_split(t: &RunTotals) -> String {
     .join(" / ")
 }
 
+/// A method as the tables name it.
+fn method_name(method: Method) -> &'static str {
+    match method {
+        Method::Alm => "ALM (DDA-3a)",
+        Method::Penalty => "penalty (DDA-3p)",
+    }
+}
+
 /// A run's mean time per factorization, ms.
 fn ms_per_factorization(t: &RunTotals) -> f64 {
     1e3 * t.timings.factorization / t.factorizations.max(1) as f64
@@ -149,11 +159,7 @@ pub fn run(
         let pct = |x: f64| format!("{:.0} %", 100.0 * x / sum);
         println!(
             "| {} | {:.3} | {} | {:.1} | {:.2} | {:.2} | {:.2} | {} | {:.2e} | {} | {} | {} | {} | {} |",
-            if method == Method::Alm {
-                "ALM (DDA-3a)"
-            } else {
-                "penalty (DDA-3p)"
-            },
+            method_name(method),
             r.wall,
             t.steps,
             t.contacts_per_step,

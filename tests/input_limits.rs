@@ -453,6 +453,8 @@ fn generate_and_bench_options_are_bounded() {
         ("--sizes", "-1"),
         ("--standing-sizes", "0"),
         ("--standing-sizes", "100000"),
+        ("--method-sizes", "0"),
+        ("--method-sizes", "100000"),
         ("--repeat", "0"),
         ("--repeat", "101"),
         ("--repeat", "-1"),

@@ -1,6 +1,6 @@
 //! `dda3d bench`: checks the options and hands over to [`crate::bench`], which times the
-//! rockfall with both methods, the scaling on generated walls, rock-mass cutting and, if asked,
-//! rock-mass scenes as they are.
+//! rockfall with both methods, the scaling on generated walls, the struck walls with both
+//! methods, rock-mass cutting and, if asked, rock-mass scenes as they are.
 
 use std::path::PathBuf;
 
@@ -32,6 +32,10 @@ pub struct BenchArgs {
     /// separated, each 1..=99998; empty: no such table).
     #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "100", allow_negative_numbers = true)]
     pub thread_sizes: Vec<usize>,
+    /// Struck wall sizes run with both methods, ALM (DDA-3a) and penalty (DDA-3p), for
+    /// `--scaling-duration` s (comma separated, each 1..=99998; empty: no such table).
+    #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "100", allow_negative_numbers = true)]
+    pub method_sizes: Vec<usize>,
     /// Rock-mass cutting: boxes cut by three joint sets into about this many blocks (comma
     /// separated, each 1..=100000).
     #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "1000,10000", allow_negative_numbers = true)]
@@ -79,6 +83,10 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
         crate::bench::thread_table(&args.thread_sizes, args.scaling_duration)
             .map_err(CliError::Run)?;
     }
+    if !args.method_sizes.is_empty() {
+        crate::bench::method_table(&args.method_sizes, args.scaling_duration)
+            .map_err(CliError::Run)?;
+    }
     if !args.cut_sizes.is_empty() {
         crate::bench::cut_table(&args.cut_sizes, args.repeat).map_err(CliError::Run)?;
     }
@@ -96,6 +104,7 @@ fn check_options(args: &BenchArgs) -> Result<(), String> {
         ("--sizes", &args.sizes),
         ("--standing-sizes", &args.standing_sizes),
         ("--thread-sizes", &args.thread_sizes),
+        ("--method-sizes", &args.method_sizes),
     ] {
         if let Some(n) = sizes.iter().find(|n| !(1..=MAX_WALL_BLOCKS).contains(n)) {
             return Err(format!(
