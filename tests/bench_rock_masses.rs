@@ -86,6 +86,7 @@ fn the_rock_mass_row_counts_what_run_counts() {
             "--sizes",
             "--standing-sizes",
             "--thread-sizes",
+            "--method-sizes",
             "--cut-sizes",
         ])
         .args(["--repeat", "1", "--rock-masses"])
