@@ -72,7 +72,7 @@ pub(crate) fn alm_loop(
         let solves = alm_k;
         let d = solve(inp, sys, active, counters, k_dirty)?;
         let watch = Stopwatch::start();
-        let (conv1, conv2) = measure(p, inp.blocks, &d, active);
+        let tests = measure(inp, &d, active);
         if p.method == Method::Penalty {
             counters.assembly += watch.elapsed();
             return Ok(AlmOutcome {
@@ -81,16 +81,14 @@ pub(crate) fn alm_loop(
                 converged: true,
             });
         }
-        let stuck = stuck(inp, active);
-        let converged = conv1 && conv2 && stuck;
+        let converged = tests.penetration && tests.multipliers && tests.stuck;
+        let update = Update {
+            alm_k,
+            converged,
+            absorb: !converged && alm_k < cp.max_alm_iterations,
+        };
         // K changes only where (P21) raised a penalty.
-        k_dirty = update_multipliers(p, (inp.blocks, &d), alm_k, converged, active);
-        if !converged && alm_k < cp.max_alm_iterations {
-            absorb_stick_slip(inp, active);
-        }
-        if !inp.settling {
-            hold_reversed_friction(inp, active);
-        }
+        k_dirty = update_contacts(inp, &d, &update, active);
         counters.assembly += watch.elapsed();
         if converged || alm_k == cp.max_alm_iterations {
             return Ok(AlmOutcome {
@@ -136,20 +134,32 @@ fn solve(
     Ok(f)
 }
 
-/// d_n and N of every contact (5.4), (5.6) for the solution `d`, and the convergence tests
-/// (P23), each contact against its own group's d_n,max, and (P24); an unchanged zero force
-/// vector counts as converged.
-fn measure(p: &SolverParams, blocks: &[Block], d: &[f64], active: &mut [Active]) -> (bool, bool) {
+/// The convergence tests of one ALM iteration.
+struct Tests {
+    /// (P23): every closed contact's |d_n| within ε1·d_n,max of its group.
+    penetration: bool,
+    /// (P24): ‖λ_k − λ_{k−1}‖ < ε2‖λ_{k−1}‖ (an unchanged zero force vector counts as converged).
+    multipliers: bool,
+    /// Every locked contact is stuck: its tangential displacement in the solve is within its
+    /// stick tolerance ([`Active::stick_tolerance`]).
+    stuck: bool,
+}
+
+/// d_n and N of every contact (5.4), (5.6) for the solution `d`, and the convergence tests,
+/// each contact against its own group's d_n,max. One pass over the contacts: at 10 000 of
+/// them their records span megabytes, and the tests were three passes.
+fn measure(inp: &AlmInputs, d: &[f64], active: &mut [Active]) -> Tests {
+    let (p, blocks) = (inp.params, inp.blocks);
     // Per contact in parallel; the sums of (P24) are then formed in the contacts' order, so
     // they do not depend on the thread count.
-    let terms: Vec<(bool, f64, f64)> = active
+    let terms: Vec<(bool, f64, f64, bool)> = active
         .par_iter_mut()
         .with_min_len(PAR_CONTACTS)
         .map(|c| {
             let (di, dj) = c.increments(d);
             c.dn = c.kin.penetration(&di, &dj);
             if c.rec.state == ContactState::Open {
-                return (true, 0.0, 0.0);
+                return (true, 0.0, 0.0, true);
             }
             let alm = p.method == Method::Alm;
             if alm {
@@ -159,87 +169,113 @@ fn measure(p: &SolverParams, blocks: &[Block], d: &[f64], active: &mut [Active])
             c.force = lambda + c.rec.penalty * c.dn;
             let within = c.dn.abs() <= p.contact.eps1 * c.dn_max(p);
             if !alm {
-                return (within, 0.0, 0.0);
+                return (within, 0.0, 0.0, true);
             }
+            let stuck = c.rec.state != ContactState::Lock
+                || tangential_slip(c).norm() <= c.stick_tolerance(p, inp.first_step);
             let new = c.force.max(0.0);
-            (within, (new - c.rec.lambda).powi(2), c.rec.lambda.powi(2))
+            (
+                within,
+                (new - c.rec.lambda).powi(2),
+                c.rec.lambda.powi(2),
+                stuck,
+            )
         })
         .collect();
-    let mut conv1 = true;
+    let mut t = Tests {
+        penetration: true,
+        multipliers: false,
+        stuck: true,
+    };
     let (mut dl2, mut l2) = (0.0, 0.0);
-    for (within, a, b) in terms {
-        conv1 &= within;
+    for (within, a, b, stuck) in terms {
+        t.penetration &= within;
+        t.stuck &= stuck;
         dl2 += a;
         l2 += b;
     }
-    let conv2 = dl2 == 0.0 || dl2.sqrt() < p.contact.eps2 * l2.sqrt();
-    (conv1, conv2)
+    t.multipliers = dl2 == 0.0 || dl2.sqrt() < p.contact.eps2 * l2.sqrt();
+    t
 }
 
-/// (P1) λ_k = λ_{k−1} + p_n d_n, kept non-negative, for every closed contact; and (P21): the
-/// penalty of a contact whose penetration does not fall fast enough is raised. Returns whether
-/// a penalty changed (K must be refactorized).
+/// What [`update_contacts`] does after the tests of ALM iteration `alm_k`.
+struct Update {
+    alm_k: u32,
+    converged: bool,
+    /// The loop goes on: the stick update of locked contacts ([`absorb_stick_slip`]).
+    absorb: bool,
+}
+
+/// Every contact's updates after an iteration's tests, in one pass: its multiplier and penalty
+/// ([`update_multipliers`]), then, as the loop requires, its stick update
+/// ([`absorb_stick_slip`]) and the hold of a reversed friction ([`hold_reversed_friction`]).
+/// Each reads and writes the contact's own record only, so doing all three to one contact
+/// before the next is the same as doing each to every contact in turn. Returns whether a
+/// penalty changed (K must be refactorized).
+fn update_contacts(inp: &AlmInputs, d: &[f64], u: &Update, active: &mut [Active]) -> bool {
+    let p = inp.params;
+    active
+        .par_iter_mut()
+        .with_min_len(PAR_CONTACTS)
+        .map(|c| {
+            let raised = update_multipliers(p, (inp.blocks, d), u.alm_k, u.converged, c);
+            if u.absorb {
+                absorb_stick_slip(inp, c);
+            }
+            if !inp.settling {
+                hold_reversed_friction(inp, c);
+            }
+            raised
+        })
+        .reduce(|| false, |a, b| a || b)
+}
+
+/// (P1) λ_k = λ_{k−1} + p_n d_n, kept non-negative, for a closed contact; and (P21): its penalty
+/// is raised if its penetration does not fall fast enough. Returns whether the penalty changed.
 fn update_multipliers(
     p: &SolverParams,
     (blocks, d): (&[Block], &[f64]),
     alm_k: u32,
     converged: bool,
-    active: &mut [Active],
+    c: &mut Active,
 ) -> bool {
     let cp = &p.contact;
-    // Each contact on its own, in parallel.
-    active
-        .par_iter_mut()
-        .with_min_len(PAR_CONTACTS)
-        .map(|c| {
-            if c.rec.state == ContactState::Open {
-                return false;
-            }
-            let mut raised = false;
-            c.rec.lambda = c.force.max(0.0);
-            // Not for a contact whose penetration is already negligible against the tolerance
-            // ε1·d_n,max: there the ratio test only sees round-off, and over many steps it
-            // ratcheted every penalty of a standing wall up to γE, a stiffness that turned a 4 µm
-            // motion into meganewtons at the next impact. Nor for a closed contact the solve pulls
-            // apart (d_n < 0): a stiffer penalty only lets it hold more tension, and the open–close
-            // check, not the penalty, deals with it. Slabs sliding together rock on their joints
-            // by micrometres; raised there a hundredfold, the penalties swung their forces by
-            // 10⁵ N and the iteration settled on states that stopped the slabs within a step.
-            if let Some(prev) = c.dn_prev
-                && alm_k <= PENALTY_ROUNDS + 1
-                && !converged
-                && (c.dn > 0.0 || -c.dn > cp.eps1 * c.dn_max(p))
-                && c.dn.abs() > cp.beta * prev.abs()
-                && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * c.dn_max(p)
-            {
-                let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
-                if capped > c.rec.penalty {
-                    c.set_penalty(capped, cp);
-                    // The spring's reference moved with p_τ, and T_b with it.
-                    c.du = c.relative_displacement(d, blocks);
-                    raised = true;
-                }
-            }
-            c.dn_prev = Some(c.dn);
-            raised
-        })
-        .reduce(|| false, |a, b| a || b)
+    if c.rec.state == ContactState::Open {
+        return false;
+    }
+    let mut raised = false;
+    c.rec.lambda = c.force.max(0.0);
+    // Not for a contact whose penetration is already negligible against the tolerance
+    // ε1·d_n,max: there the ratio test only sees round-off, and over many steps it
+    // ratcheted every penalty of a standing wall up to γE, a stiffness that turned a 4 µm
+    // motion into meganewtons at the next impact. Nor for a closed contact the solve pulls
+    // apart (d_n < 0): a stiffer penalty only lets it hold more tension, and the open–close
+    // check, not the penalty, deals with it. Slabs sliding together rock on their joints
+    // by micrometres; raised there a hundredfold, the penalties swung their forces by
+    // 10⁵ N and the iteration settled on states that stopped the slabs within a step.
+    if let Some(prev) = c.dn_prev
+        && alm_k <= PENALTY_ROUNDS + 1
+        && !converged
+        && (c.dn > 0.0 || -c.dn > cp.eps1 * c.dn_max(p))
+        && c.dn.abs() > cp.beta * prev.abs()
+        && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * c.dn_max(p)
+    {
+        let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
+        if capped > c.rec.penalty {
+            c.set_penalty(capped, cp);
+            // The spring's reference moved with p_τ, and T_b with it.
+            c.du = c.relative_displacement(d, blocks);
+            raised = true;
+        }
+    }
+    c.dn_prev = Some(c.dn);
+    raised
 }
 
 /// The tangential part of a closed contact's relative displacement in the last solve, m.
 fn tangential_slip(c: &Active) -> crate::physics::geometry::Vec3 {
     let n = c.cand.normal;
     c.du - n * n.dot(&c.du)
-}
-
-/// Every locked contact is stuck: its tangential displacement in the last solve is within
-/// its stick tolerance.
-fn stuck(inp: &AlmInputs, active: &[Active]) -> bool {
-    active
-        .par_iter()
-        .with_min_len(PAR_CONTACTS)
-        .filter(|c| c.rec.state == ContactState::Lock)
-        .all(|c| tangential_slip(c).norm() <= c.stick_tolerance(inp.params, inp.first_step))
 }
 
 /// The augmented Lagrangian update of a locked contact's shear, as (P1) is of its normal force:
@@ -256,19 +292,14 @@ fn stuck(inp: &AlmInputs, active: &[Active]) -> bool {
 /// the contact law does not count. With ε1·d_n,max there too, 5 × 10 m blocks took up their load
 /// with 0.12 mm of slip; with f0·w0 in every step, a struck wall of 100 blocks needed 158 solves
 /// a step instead of 99 (57 with no stick update).
-fn absorb_stick_slip(inp: &AlmInputs, active: &mut [Active]) {
-    active
-        .par_iter_mut()
-        .with_min_len(PAR_CONTACTS)
-        .for_each(|c| {
-            if c.rec.state == ContactState::Lock {
-                let slip = tangential_slip(c);
-                c.rec.reference -= slip;
-                if !inp.params.joints_held && !inp.first_step {
-                    c.cap_shear(inp.params);
-                }
-            }
-        });
+fn absorb_stick_slip(inp: &AlmInputs, c: &mut Active) {
+    if c.rec.state == ContactState::Lock {
+        let slip = tangential_slip(c);
+        c.rec.reference -= slip;
+        if !inp.params.joints_held && !inp.first_step {
+            c.cap_shear(inp.params);
+        }
+    }
 }
 
 /// A sliding contact whose slip has reversed is in the wrong state, and its friction, from
@@ -277,16 +308,11 @@ fn absorb_stick_slip(inp: &AlmInputs, active: &mut [Active]) {
 /// displacement within 20 iterations, and the open–close check then classified every contact
 /// from that solution. The friction of such a contact is held at its present value for the rest
 /// of the pass (a change of F only: no refactorization); the open–close check locks it.
-fn hold_reversed_friction(inp: &AlmInputs, active: &mut [Active]) {
-    active
-        .par_iter_mut()
-        .with_min_len(PAR_CONTACTS)
-        .for_each(|c| {
-            if c.rec.state != ContactState::Slide || c.frozen || c.friction_cap.is_some() {
-                return;
-            }
-            if law::reversed(&c.du, &c.rec.tau, c.slip_tolerance(inp.params)) {
-                c.friction_cap = Some(c.rec.lambda);
-            }
-        });
+fn hold_reversed_friction(inp: &AlmInputs, c: &mut Active) {
+    if c.rec.state != ContactState::Slide || c.frozen || c.friction_cap.is_some() {
+        return;
+    }
+    if law::reversed(&c.du, &c.rec.tau, c.slip_tolerance(inp.params)) {
+        c.friction_cap = Some(c.rec.lambda);
+    }
 }
