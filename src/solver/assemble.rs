@@ -8,9 +8,9 @@ use super::active::{Active, StiffnessKey};
 use super::{PAR_BLOCKS, PAR_CONTACTS};
 use crate::contact::ContactState;
 use crate::contact::kinematics::{
-    ContactForces, ContactStiffness, StiffnessBlock, add_friction, add_friction_tangent,
-    add_friction_tangent_block, add_normal_force, add_normal_stiffness, add_normal_stiffness_block,
-    add_shear_spring_force, add_shear_spring_stiffness, add_shear_spring_stiffness_block,
+    ContactForces, ContactStiffness, StiffnessBlock, add_friction, add_friction_tangent_block,
+    add_normal_force, add_normal_stiffness_block, add_shear_spring_force,
+    add_shear_spring_stiffness_block,
 };
 use crate::model::Block;
 use crate::params::{ContactParams, Method, SolverParams};
@@ -18,7 +18,7 @@ use crate::physics::geometry::Vec3;
 use crate::physics::integrator::Scheme;
 use crate::physics::linear::BlockMatrix;
 use crate::physics::mechanics::{
-    BlockStepInput, BlockTerms, Mat12, Vec12, block_terms as block_step_terms,
+    BlockStepInput, BlockTerms, Mat3x12, Mat12, Vec12, block_terms as block_step_terms,
 };
 
 /// The sparsity pattern of a step: block pairs with a contact now, plus pairs of the last
@@ -107,22 +107,7 @@ pub(crate) fn contact_stiffness(
     key: &StiffnessKey,
 ) -> ContactStiffness {
     let mut t = ContactStiffness::default();
-    add_normal_stiffness(&mut t, &c.kin, key.penalty);
-    if key.lock {
-        let tb = c.tb_at(&key.reference, blocks);
-        let p_tau = cp.shear_penalty(key.penalty);
-        add_shear_spring_stiffness(&mut t, &c.ta(blocks), &tb, &c.cand.normal, p_tau);
-    } else if key.lateral > 0.0 {
-        let tb = c.tb_at(&c.cand.xb, blocks);
-        add_friction_tangent(
-            &mut t,
-            &c.ta(blocks),
-            &tb,
-            &c.cand.normal,
-            &key.tau,
-            key.lateral,
-        );
-    }
+    add_contact_stiffness(t.blocks_mut(), cp, blocks, c, key);
     t
 }
 
@@ -135,17 +120,49 @@ fn contact_stiffness_block(
     which: StiffnessBlock,
 ) -> Mat12 {
     let mut m = Mat12::zeros();
-    add_normal_stiffness_block(&mut m, which, &c.kin, key.penalty);
-    if key.lock {
-        let tb = c.tb_at(&key.reference, blocks);
-        let p_tau = cp.shear_penalty(key.penalty);
-        add_shear_spring_stiffness_block(&mut m, which, &c.ta(blocks), &tb, &c.cand.normal, p_tau);
-    } else if key.lateral > 0.0 {
-        let tb = c.tb_at(&c.cand.xb, blocks);
-        let (n, tau) = (&c.cand.normal, &key.tau);
-        add_friction_tangent_block(&mut m, which, &c.ta(blocks), &tb, n, tau, key.lateral);
-    }
+    add_contact_stiffness([(&mut m, which)], cp, blocks, c, key);
     m
+}
+
+/// Adds to each of `targets` its block of the contact's stiffness (see [`contact_stiffness`]):
+/// the normal part, then the tangential one, each block by the same operations however many
+/// are asked for.
+fn add_contact_stiffness<'m>(
+    targets: impl IntoIterator<Item = (&'m mut Mat12, StiffnessBlock)>,
+    cp: &ContactParams,
+    blocks: &[Block],
+    c: &Active,
+    key: &StiffnessKey,
+) {
+    // The tangential part, with T_b taken once for all the blocks asked for.
+    enum Tangential {
+        None,
+        /// A locked contact's shear spring.
+        Spring(Mat3x12),
+        /// A sliding contact's friction turning with the slip (k⊥ > 0).
+        Friction(Mat3x12),
+    }
+    let tangential = if key.lock {
+        Tangential::Spring(c.tb_at(&key.reference, blocks))
+    } else if key.lateral > 0.0 {
+        Tangential::Friction(c.tb_at(&c.cand.xb, blocks))
+    } else {
+        Tangential::None
+    };
+    let (n, ta) = (&c.cand.normal, c.ta(blocks));
+    for (m, which) in targets {
+        add_normal_stiffness_block(m, which, &c.kin, key.penalty);
+        match &tangential {
+            Tangential::Spring(tb) => {
+                let p_tau = cp.shear_penalty(key.penalty);
+                add_shear_spring_stiffness_block(m, which, &ta, tb, n, p_tau);
+            }
+            Tangential::Friction(tb) => {
+                add_friction_tangent_block(m, which, &ta, tb, n, &key.tau, key.lateral);
+            }
+            Tangential::None => {}
+        }
+    }
 }
 
 /// Adds (`sign` = 1) or removes (−1) the stiffness of contact `c` in the state `key`.
