@@ -104,6 +104,19 @@ fn stage_split(t: &RunTotals) -> String {
     .join(" / ")
 }
 
+/// A run's open–close passes, solves and factorizations a step, as the tables print them.
+fn iterations_per_step(t: &RunTotals) -> String {
+    let steps = t.steps.max(1) as f64;
+    [t.open_close_iterations, t.alm_iterations, t.factorizations]
+        .map(|n| format!("{:.2}", n as f64 / steps))
+        .join(" | ")
+}
+
+/// The ALM run's wall time per step over the penalty run's, from each run's (wall time, steps).
+fn per_step_ratio((alm, alm_steps): (f64, f64), (penalty, penalty_steps): (f64, f64)) -> f64 {
+    (alm / alm_steps) / (penalty / penalty_steps)
+}
+
 /// A method as the tables name it.
 fn method_name(method: Method) -> &'static str {
     match method {
@@ -158,14 +171,12 @@ pub fn run(
         let sum = tm.detection + tm.assembly + tm.factorization + tm.solve + tm.bookkeeping;
         let pct = |x: f64| format!("{:.0} %", 100.0 * x / sum);
         println!(
-            "| {} | {:.3} | {} | {:.1} | {:.2} | {:.2} | {:.2} | {} | {:.2e} | {} | {} | {} | {} | {} |",
+            "| {} | {:.3} | {} | {:.1} | {} | {} | {:.2e} | {} | {} | {} | {} | {} |",
             method_name(method),
             r.wall,
             t.steps,
             t.contacts_per_step,
-            t.open_close_iterations as f64 / steps,
-            t.alm_iterations as f64 / steps,
-            t.factorizations as f64 / steps,
+            iterations_per_step(t),
             t.time_step_cuts,
             t.max_penetration,
             pct(tm.detection),
@@ -186,7 +197,7 @@ pub fn run(
     // the method itself.
     println!(
         "ALM / penalty wall time per step: {:.2} ({alm_steps} and {penalty_steps} steps)\n",
-        (alm / alm_steps) / (penalty / penalty_steps)
+        per_step_ratio(walls[0], walls[1])
     );
 
     if !sizes.is_empty() {

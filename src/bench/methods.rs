@@ -4,7 +4,7 @@
 //! open–close passes and solves a step, the steps settled at the pass limit, and the accuracy
 //! each method buys (the largest penetration).
 
-use super::{best_of, generated_wall, method_name};
+use super::{best_of, generated_wall, iterations_per_step, method_name, per_step_ratio};
 use crate::params::Method;
 
 /// Prints the method comparison for struck walls of `sizes` blocks, one run each.
@@ -25,24 +25,21 @@ pub fn method_table(sizes: &[usize], duration: f64) -> Result<(), String> {
             let t = &r.totals;
             let steps = t.steps.max(1) as f64;
             println!(
-                "| {n} | {} | {:.3} | {:.3} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2e} |",
+                "| {n} | {} | {:.3} | {:.3} | {} | {} | {} | {:.2e} |",
                 method_name(method),
                 r.wall,
                 r.wall / r.simulated,
                 t.steps,
-                t.open_close_iterations as f64 / steps,
-                t.alm_iterations as f64 / steps,
-                t.factorizations as f64 / steps,
+                iterations_per_step(t),
                 t.unconverged_steps,
                 t.max_penetration,
             );
             runs.push((r.wall, steps));
         }
-        let ((alm, alm_steps), (penalty, penalty_steps)) = (runs[0], runs[1]);
         println!(
             "| {n} | ALM / penalty | {:.2} | | {:.2} per step | | | | | |",
-            alm / penalty,
-            (alm / alm_steps) / (penalty / penalty_steps)
+            runs[0].0 / runs[1].0,
+            per_step_ratio(runs[0], runs[1])
         );
     }
     Ok(())

@@ -82,13 +82,8 @@ pub(crate) fn alm_loop(
             });
         }
         let converged = tests.penetration && tests.multipliers && tests.stuck;
-        let update = Update {
-            alm_k,
-            converged,
-            absorb: !converged && alm_k < cp.max_alm_iterations,
-        };
         // K changes only where (P21) raised a penalty.
-        k_dirty = update_contacts(inp, &d, &update, active);
+        k_dirty = update_contacts(inp, &d, alm_k, converged, active);
         counters.assembly += watch.elapsed();
         if converged || alm_k == cp.max_alm_iterations {
             return Ok(AlmOutcome {
@@ -198,28 +193,27 @@ fn measure(inp: &AlmInputs, d: &[f64], active: &mut [Active]) -> Tests {
     t
 }
 
-/// What [`update_contacts`] does after the tests of ALM iteration `alm_k`.
-struct Update {
-    alm_k: u32,
-    converged: bool,
-    /// The loop goes on: the stick update of locked contacts ([`absorb_stick_slip`]).
-    absorb: bool,
-}
-
-/// Every contact's updates after an iteration's tests, in one pass: its multiplier and penalty
-/// ([`update_multipliers`]), then, as the loop requires, its stick update
-/// ([`absorb_stick_slip`]) and the hold of a reversed friction ([`hold_reversed_friction`]).
+/// Every contact's updates after the tests of ALM iteration `alm_k`, in one pass: its
+/// multiplier and penalty ([`update_multipliers`]), then, if the loop goes on, its stick update
+/// ([`absorb_stick_slip`]), and the hold of a reversed friction ([`hold_reversed_friction`]).
 /// Each reads and writes the contact's own record only, so doing all three to one contact
 /// before the next is the same as doing each to every contact in turn. Returns whether a
 /// penalty changed (K must be refactorized).
-fn update_contacts(inp: &AlmInputs, d: &[f64], u: &Update, active: &mut [Active]) -> bool {
+fn update_contacts(
+    inp: &AlmInputs,
+    d: &[f64],
+    alm_k: u32,
+    converged: bool,
+    active: &mut [Active],
+) -> bool {
     let p = inp.params;
+    let goes_on = !converged && alm_k < p.contact.max_alm_iterations;
     active
         .par_iter_mut()
         .with_min_len(PAR_CONTACTS)
         .map(|c| {
-            let raised = update_multipliers(p, (inp.blocks, d), u.alm_k, u.converged, c);
-            if u.absorb {
+            let raised = update_multipliers(p, (inp.blocks, d), alm_k, converged, c);
+            if goes_on {
                 absorb_stick_slip(inp, c);
             }
             if !inp.settling {
