@@ -67,6 +67,32 @@ origin = [1.0, 0.0, 0.0]
     path
 }
 
+/// `dda3d bench ARGS`, which must succeed: its standard output.
+fn bench_stdout(args: &[&str]) -> String {
+    let out = bin().arg("bench").args(args).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// `dda3d run SCENE ARGS --quiet --out OUT`, which must succeed: its `summary.json`.
+fn run_summary(scene: &Path, args: &[&str], out: &Path) -> serde_json::Value {
+    let status = bin()
+        .arg("run")
+        .arg(scene)
+        .args(args)
+        .args(["--quiet", "--out"])
+        .arg(out)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
+}
+
 /// The cells of the table row that begins with the cells `first`.
 fn row<'a>(stdout: &'a str, first: &[&str]) -> Vec<&'a str> {
     let start = format!("| {} |", first.join(" | "));
@@ -81,40 +107,22 @@ fn row<'a>(stdout: &'a str, first: &[&str]) -> Vec<&'a str> {
 fn the_rock_mass_row_counts_what_run_counts() {
     let dir = tmp("counts");
     let scene = small_mass(&dir, 3);
-    let out = bin()
-        .args([
-            "bench",
-            "--sizes",
-            "--standing-sizes",
-            "--thread-sizes",
-            "--method-sizes",
-            "--cut-sizes",
-        ])
-        .args(["--repeat", "1", "--rock-masses"])
-        .arg(&scene)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let cells = row(&stdout, &[&scene.display().to_string()]);
+    let scene_name = scene.display().to_string();
+    let stdout = bench_stdout(&[
+        "--sizes",
+        "--standing-sizes",
+        "--thread-sizes",
+        "--method-sizes",
+        "--cut-sizes",
+        "--repeat",
+        "1",
+        "--rock-masses",
+        &scene_name,
+    ]);
+    let cells = row(&stdout, &[&scene_name]);
     assert_eq!(cells.len(), 16, "{cells:?}");
 
-    let run_dir = dir.join("run");
-    let status = bin()
-        .arg("run")
-        .arg(&scene)
-        .args(["--quiet", "--out"])
-        .arg(&run_dir)
-        .status()
-        .unwrap();
-    assert!(status.success());
-    let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(run_dir.join("summary.json")).unwrap())
-            .unwrap();
+    let summary = run_summary(&scene, &[], &dir.join("run"));
     let eq = &summary["equilibrium"];
     // blocks: the slab and the four cut blocks.
     assert_eq!(cells[1], "5");
@@ -165,54 +173,24 @@ fn a_missing_or_bad_rock_mass_scene_is_bad_input() {
     }
 }
 
-/// `dda3d run` on `scene` with `method` for `duration` s: its `summary.json`.
-fn run_summary(scene: &Path, method: &str, duration: &str, out: &Path) -> serde_json::Value {
-    let status = bin()
-        .arg("run")
-        .arg(scene)
-        .args([
-            "--method",
-            method,
-            "--duration",
-            duration,
-            "--quiet",
-            "--out",
-        ])
-        .arg(out)
-        .status()
-        .unwrap();
-    assert!(status.success());
-    serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap()
-}
-
 #[test]
 fn each_method_row_of_the_struck_walls_counts_what_run_counts() {
     let dir = tmp("methods");
     let n = 10;
     let size = n.to_string();
     let duration = "0.3";
-    let out = bin()
-        .args([
-            "bench",
-            "--sizes",
-            "--standing-sizes",
-            "--thread-sizes",
-            "--cut-sizes",
-            "--repeat",
-            "1",
-            "--scaling-duration",
-            duration,
-            "--method-sizes",
-            &size,
-        ])
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let stdout = bench_stdout(&[
+        "--sizes",
+        "--standing-sizes",
+        "--thread-sizes",
+        "--cut-sizes",
+        "--repeat",
+        "1",
+        "--scaling-duration",
+        duration,
+        "--method-sizes",
+        &size,
+    ]);
     let wall = dir.join("wall.toml");
     let status = bin()
         .args(["generate", "column", "--blocks", &n.to_string(), "--out"])
@@ -224,7 +202,8 @@ fn each_method_row_of_the_struck_walls_counts_what_run_counts() {
     for (method, label) in [("alm", "ALM (DDA-3a)"), ("penalty", "penalty (DDA-3p)")] {
         let cells = row(&stdout, &[&size, label]);
         assert_eq!(cells.len(), 10, "{cells:?}");
-        let s = run_summary(&wall, method, duration, &dir.join(method));
+        let args = ["--method", method, "--duration", duration];
+        let s = run_summary(&wall, &args, &dir.join(method));
         let steps = s["steps"].as_u64().unwrap();
         let per_step = |key: &str| format!("{:.2}", s[key].as_u64().unwrap() as f64 / steps as f64);
         assert_eq!(cells[4], steps.to_string(), "{label}: steps");
