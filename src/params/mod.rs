@@ -91,6 +91,11 @@ pub struct ContactParams {
     pub eps1: f64,
     /// ε2 of (P24): relative change of the contact forces between ALM iterations.
     pub eps2: f64,
+    /// Penetrations below this fraction of ε1·d_n,max do not raise the penalty by (P21). The
+    /// paper has no such floor; 0.01 keeps a sliding jointed mass free (raised penalties jam it
+    /// at block edges), 0 lets (P21) stiffen the contacts of stacked blocks, which otherwise
+    /// self-excite (see `crate::solver`'s ALM loop, `update_multipliers`).
+    pub penalty_floor: f64,
     /// p_τ / p_n,1: the shear spring of locked contacts (the paper does not give p_τ; Shi's
     /// code uses p_n / 2.5).
     pub shear_penalty_ratio: f64,
@@ -139,6 +144,7 @@ impl Default for ContactParams {
             gamma: 100.0,
             eps1: 0.01,
             eps2: 0.01,
+            penalty_floor: 0.01,
             shear_penalty_ratio: 1.0 / 2.5,
             max_alm_iterations: 20,
             max_open_close_iterations: 30,
@@ -481,6 +487,7 @@ mod tests {
             &MAX_DISPLACEMENT_RATIO,
             &EPS1,
             &EPS2,
+            &PENALTY_FLOOR,
             &MAX_ALM_ITERATIONS,
             &MAX_OPEN_CLOSE_ITERATIONS,
             &CLOSE_THRESHOLD,

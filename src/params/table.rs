@@ -411,7 +411,7 @@ pub fn find(name: &str) -> Option<&'static Param> {
 }
 
 /// Every key, in the scene file's order (`[solver]`, `[solver.contact]`, `[joint]`).
-pub const ALL: [&Param; 27] = [
+pub const ALL: [&Param; 28] = [
     &METHOD,
     &MODE,
     &SPECTRAL_RADIUS,
@@ -431,6 +431,7 @@ pub const ALL: [&Param; 27] = [
     &GAMMA,
     &EPS1,
     &EPS2,
+    &PENALTY_FLOOR,
     &SHEAR_PENALTY_RATIO,
     &MAX_ALM_ITERATIONS,
     &MAX_OPEN_CLOSE_ITERATIONS,

@@ -20,9 +20,6 @@ use crate::physics::mechanics::{Mat12, Vec12};
 /// means a new factorization; later iterations only update λ and reuse it (back-substitutions).
 const PENALTY_ROUNDS: u32 = 2;
 
-/// Penetrations below this fraction of the ALM tolerance ε1·d_n,max do not raise the penalty.
-const PENALTY_FLOOR: f64 = 0.01;
-
 /// What an ALM loop reads and does not change.
 pub(crate) struct AlmInputs<'a> {
     pub params: &'a SolverParams,
@@ -239,10 +236,16 @@ fn update_multipliers(
     }
     let mut raised = false;
     c.rec.lambda = c.force.max(0.0);
-    // Not for a contact whose penetration is already negligible against the tolerance
-    // ε1·d_n,max: there the ratio test only sees round-off, and over many steps it
-    // ratcheted every penalty of a standing wall up to γE, a stiffness that turned a 4 µm
-    // motion into meganewtons at the next impact. Nor for a closed contact the solve pulls
+    // Not for a contact whose penetration is below `penalty_floor` of the tolerance
+    // ε1·d_n,max (0.01 by default): over many steps the ratio test ratcheted every penalty of
+    // a standing wall up to γE, a stiffness that turned a 4 µm motion into meganewtons at the
+    // next impact, and raised penalties jam a sliding jointed mass at its blocks' edges. The
+    // floor has a price in stacked blocks: λ carried from step to step is an integral of the
+    // penetration, and where the loop ends before it converges (a stack's rocking modes
+    // contract by a few per cent an iteration at p_n,1) the force lags the motion and feeds
+    // it. A column of four blocks on a fixed one then rocks at 2.5 mm/s indefinitely; with
+    // the floor at 0, (P21) stiffens its contacts and it comes to rest (`penalty_floor`'s
+    // table entry, `tests/stable_dynamics.rs`). Nor for a closed contact the solve pulls
     // apart (d_n < 0): a stiffer penalty only lets it hold more tension, and the open–close
     // check, not the penalty, deals with it. Slabs sliding together rock on their joints
     // by micrometres; raised there a hundredfold, the penalties swung their forces by
@@ -252,7 +255,7 @@ fn update_multipliers(
         && !converged
         && (c.dn > 0.0 || -c.dn > cp.eps1 * c.dn_max(p))
         && c.dn.abs() > cp.beta * prev.abs()
-        && c.dn.abs() > PENALTY_FLOOR * cp.eps1 * c.dn_max(p)
+        && c.dn.abs() > cp.penalty_floor * cp.eps1 * c.dn_max(p)
     {
         let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
         if capped > c.rec.penalty {

@@ -94,6 +94,27 @@ pub const EPS2: Param = Param {
     widget: absolute(1e-4, 0.5, true),
 };
 
+pub const PENALTY_FLOOR: Param = Param {
+    key: "solver.contact.penalty_floor",
+    label: "(P21) floor",
+    unit: "ε1·d_n,max",
+    doc: "(P21) raises a contact's penalty only where its penetration exceeds this fraction of \
+          the tolerance ε1·d_n,max. 0.01 keeps the penalties of a sliding jointed mass low: \
+          raised, they jam its blocks at their edges (the shipped jointed slope's free blocks \
+          travel a median 0.24 m by 1 s at 0, 0.84 m at 0.01; Coulomb 0.95 m). 0 lets \
+          (P21) stiffen the contacts of stacked blocks, which at 0.01 self-excite: a column of \
+          four blocks on a fixed one rocks at 2.5 mm/s for as long as the run lasts (3 cm/s at \
+          Δt = 2 ms), still at 0. Set 0 for walls and columns without a sliding mass. The \
+          paper has no floor.",
+    default: Value::Real(0.01),
+    get: |p| Value::Real(p.contact.penalty_floor),
+    set: |p, text| assign(text, &mut p.contact.penalty_floor),
+    valid: Interval::new(Bound::Closed(0.0), Bound::Closed(1.0)),
+    valid_why: "above 1 a contact's penetration would have to exceed its whole tolerance \
+          ε1·d_n,max before its penalty could grow, and the ALM loop would end first.",
+    widget: absolute(0.0, 0.05, false),
+};
+
 pub const SHEAR_PENALTY_RATIO: Param = Param {
     key: "solver.contact.shear_penalty_ratio",
     label: "p_τ / p_n,1",

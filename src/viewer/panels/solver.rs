@@ -115,6 +115,15 @@ fn tolerance_rows(ui: &mut egui::Ui, e: &mut SolverParams, model: &Model) {
     ui.add_enabled(alm, param_slider(&mut c.eps2, &table::EPS2, model.young));
     ui.label("");
     ui.end_row();
+
+    ui.add_enabled_ui(alm, |ui| param_label(ui, &table::PENALTY_FLOOR));
+    ui.add_enabled(
+        alm,
+        param_slider(&mut c.penalty_floor, &table::PENALTY_FLOOR, model.young),
+    );
+    ui.label(RichText::new(format!("≥ {}", length(c.penalty_floor * c.eps1 * d_n_max))).weak())
+        .on_hover_text("penetrations below this do not raise p_n (P21)");
+    ui.end_row();
 }
 
 /// Joint strength: φ and c (Mohr–Coulomb) of `[joint]`, then of each joint set of the scene's
