@@ -103,7 +103,7 @@ pub const PENALTY_FLOOR: Param = Param {
           raised, they jam its blocks at their edges (the shipped jointed slope's free blocks \
           travel a median 0.24 m by 1 s at 0, 0.84 m at 0.01; Coulomb 0.95 m). 0 lets \
           (P21) stiffen the contacts of stacked blocks, which at 0.01 self-excite: a column of \
-          four blocks on a fixed one rocks at 2.5 mm/s for as long as the run lasts (3 cm/s at \
+          four blocks on a fixed one rocks at 2.7 mm/s for as long as the run lasts (4 cm/s at \
           Δt = 2 ms), still at 0. Set 0 for walls and columns without a sliding mass. The \
           paper has no floor.",
     default: Value::Real(0.01),
