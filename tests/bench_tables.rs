@@ -3,21 +3,9 @@
 //! equilibrium stage apart; `--method-sizes`: the struck walls with both methods.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_dda3d"));
-    // bench's default rockfall scene is relative to the repository.
-    c.current_dir(env!("CARGO_MANIFEST_DIR"));
-    c
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dda3d-bench-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod cli_support;
+use cli_support::{bin, tmp};
 
 /// A 2 m cube cut by a horizontal and a vertical joint (four blocks) on a fixed slab, with an
 /// equilibrium stage of at most `stage_steps` steps, run for two steps of 0.01 s.

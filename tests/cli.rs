@@ -2,11 +2,9 @@
 //! status 2 for bad input.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_dda3d"))
-}
+mod cli_support;
+use cli_support::{bin, tmp};
 
 /// `dda3d run SCENE --out OUT`, its output captured.
 fn run_scene(scene: &Path, out: &Path) -> std::process::Output {
@@ -21,13 +19,6 @@ fn run_scene(scene: &Path, out: &Path) -> std::process::Output {
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes")
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dda3d-cli-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 #[test]

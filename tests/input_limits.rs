@@ -2,22 +2,11 @@
 //! Families of bad values for every bounded input, each through the binary: exit status 2, one
 //! line on stderr naming the file, the TOML line and the key (or the flag), no panic.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
 
-fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_dda3d"));
-    // bench's default scene is relative to the repository.
-    c.current_dir(env!("CARGO_MANIFEST_DIR"));
-    c
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dda3d-limits-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod cli_support;
+use cli_support::{bin, tmp};
 
 /// One block on nothing, with `extra` appended to its `[[blocks]]` entry (line 9 onwards).
 fn scene(extra: &str) -> String {

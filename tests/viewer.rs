@@ -12,24 +12,16 @@ mod window_support;
 
 use window_support::{finish, have_xvfb_run, skip_or_fail};
 
+mod cli_support;
+use cli_support::{bin, tmp};
+
 const WIDTH: u32 = 1280;
 const HEIGHT: u32 = 720;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_dda3d"))
-}
 
 fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenes")
         .join(name)
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dda3d-viewer-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 /// Fraction of pixels in the rectangle that differ clearly from its first pixel.

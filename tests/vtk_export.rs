@@ -6,22 +6,14 @@
 //! `python3`). Where it cannot import vtk the check is skipped with a notice, unless
 //! `DDA3D_REQUIRE_VTK=1` (set by `.ci/run`, which installs it) makes that a failure.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_dda3d"))
-}
+mod cli_support;
+use cli_support::{bin, tmp};
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dda3d-vtk-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
 }
 
 /// `dda3d run ARGS --out OUT -q`, which must succeed.
