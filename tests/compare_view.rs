@@ -12,7 +12,7 @@ use std::process::{Command, Stdio};
 
 mod window_support;
 
-use window_support::{finish, have_xvfb_run, skip_or_fail};
+use window_support::{distance, finish, have_xvfb_run, skip_or_fail, variation};
 
 mod cli_support;
 use cli_support::{bin, tmp};
@@ -21,24 +21,6 @@ fn rockfall() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenes")
         .join("rock_column_rockfall.toml")
-}
-
-/// Fraction of pixels in the rectangle that differ clearly from its first pixel.
-fn variation(img: &image::RgbImage, [x0, y0, x1, y1]: [u32; 4]) -> f64 {
-    let first = *img.get_pixel(x0, y0);
-    let mut differ = 0usize;
-    for y in y0..y1 {
-        for x in x0..x1 {
-            if distance(img.get_pixel(x, y), &first) > 24 {
-                differ += 1;
-            }
-        }
-    }
-    differ as f64 / ((x1 - x0) * (y1 - y0)) as f64
-}
-
-fn distance(p: &image::Rgb<u8>, q: &image::Rgb<u8>) -> i32 {
-    (0..3).map(|k| (p[k] as i32 - q[k] as i32).abs()).sum()
 }
 
 /// Fraction of pixels that differ clearly between two rectangles of one size.

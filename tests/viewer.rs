@@ -10,7 +10,7 @@ use std::process::{Command, Stdio};
 
 mod window_support;
 
-use window_support::{finish, have_xvfb_run, skip_or_fail};
+use window_support::{finish, have_xvfb_run, skip_or_fail, variation};
 
 mod cli_support;
 use cli_support::{bin, tmp};
@@ -22,24 +22,6 @@ fn scene(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("scenes")
         .join(name)
-}
-
-/// Fraction of pixels in the rectangle that differ clearly from its first pixel.
-fn variation(img: &image::RgbImage, x0: u32, y0: u32, x1: u32, y1: u32) -> f64 {
-    let first = *img.get_pixel(x0, y0);
-    let mut differ = 0usize;
-    let mut n = 0usize;
-    for y in y0..y1 {
-        for x in x0..x1 {
-            let p = img.get_pixel(x, y);
-            let d: i32 = (0..3).map(|k| (p[k] as i32 - first[k] as i32).abs()).sum();
-            if d > 24 {
-                differ += 1;
-            }
-            n += 1;
-        }
-    }
-    differ as f64 / n as f64
 }
 
 /// Whether any pixel of the rectangle is within `tol` (per channel) of `rgb`.
@@ -105,8 +87,8 @@ fn window_screenshot_under_xvfb() {
     // Left panel (parameters) and the 3-D view to its right, away from the toolbar and plots.
     let panel = [8, 50, 290, 480];
     let view = [480, 60, 1270, 500];
-    let pv = variation(&img, panel[0], panel[1], panel[2], panel[3]);
-    let vv = variation(&img, view[0], view[1], view[2], view[3]);
+    let pv = variation(&img, panel);
+    let vv = variation(&img, view);
     assert!(
         pv > 0.02,
         "panel region is uniform ({pv:.4} of pixels differ)"

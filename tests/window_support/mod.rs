@@ -42,3 +42,22 @@ pub fn finish(mut child: Child) -> (ExitStatus, String) {
     let out = child.wait_with_output().unwrap();
     (status, String::from_utf8_lossy(&out.stderr).into_owned())
 }
+
+/// Fraction of pixels in the rectangle that differ clearly from its first pixel.
+pub fn variation(img: &image::RgbImage, [x0, y0, x1, y1]: [u32; 4]) -> f64 {
+    let first = *img.get_pixel(x0, y0);
+    let mut differ = 0usize;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            if distance(img.get_pixel(x, y), &first) > 24 {
+                differ += 1;
+            }
+        }
+    }
+    differ as f64 / ((x1 - x0) * (y1 - y0)) as f64
+}
+
+/// The sum of the channels' absolute differences of two pixels.
+pub fn distance(p: &image::Rgb<u8>, q: &image::Rgb<u8>) -> i32 {
+    (0..3).map(|k| (p[k] as i32 - q[k] as i32).abs()).sum()
+}
