@@ -243,7 +243,7 @@ fn update_multipliers(
     // floor has a price in stacked blocks: λ carried from step to step is an integral of the
     // penetration, and where the loop ends before it converges (a stack's rocking modes
     // contract by a few per cent an iteration at p_n,1) the force lags the motion and feeds
-    // it. A column of four blocks on a fixed one then rocks at 2.5 mm/s indefinitely; with
+    // it. A column of four blocks on a fixed one then rocks at 2.7 mm/s indefinitely; with
     // the floor at 0, (P21) stiffens its contacts and it comes to rest (`penalty_floor`'s
     // table entry, `tests/stable_dynamics.rs`). Nor for a closed contact the solve pulls
     // apart (d_n < 0): a stiffer penalty only lets it hold more tension, and the open–close
