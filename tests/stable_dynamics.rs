@@ -409,9 +409,8 @@ fn stack_speed(
     while !solver.finished() {
         solver.step().expect("runs");
         if solver.time > duration - 1.0 {
-            for b in solver.snapshot().blocks.iter().filter(|b| !b.fixed) {
-                let v = b.velocity;
-                fastest = fastest.max((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt());
+            for b in solver.model.blocks.iter().filter(|b| !b.fixed) {
+                fastest = fastest.max(b.velocity.fixed_rows::<3>(0).norm());
             }
         }
     }
