@@ -417,18 +417,17 @@ fn stack_speed(
     fastest
 }
 
-/// Stacked blocks come to rest once (P21) may stiffen their contacts (`penalty_floor = 0`),
-/// and self-excite at the default floor of 0.01: a family of columns of 3 to 6 free blocks on a
-/// fixed one, alone and three side by side, at Δt_max 10 ms and 2 ms, run for 3 s. With the
-/// default, the multipliers carried from step to step lag the motion and feed it: every case
-/// rocks at 1 mm/s to 7 cm/s in the last second. At 0 every case is at least five times slower
-/// than at 0.01, and the single columns at the paper's Δt are still (at most 10⁻⁶ m/s); three
-/// of the sixteen keep rocking at 0.3–3 mm/s: there (P24) holds at the first solve of almost
-/// every step, so (P21) gets no iteration in which to stiffen the contacts further (raising
-/// the cap γE tenfold changes nothing).
+/// Stacked blocks stand still: a family of columns of 3 to 6 free blocks on a fixed one, alone
+/// and three side by side, at Δt_max 10 ms and 2 ms, run for 3 s. Before the warm start carried
+/// the multiplier of the last solve (`commit::commit_contact`), every case rocked by itself at
+/// 1 mm/s to 7 cm/s in the last second. Now every case at 10 ms is still at the default (at
+/// most 10⁻⁹ m/s measured) and every case at either step is still with `penalty_floor = 0` (at
+/// most 2·10⁻⁸ m/s). At 2 ms and the default floor of 0.01 the columns still rock, at up to
+/// centimetres a second: each ALM iteration there shrinks their penetration by a few per cent,
+/// the loop ends at its cap, and the floor keeps (P21) from stiffening them.
 #[test]
-fn stacked_columns_come_to_rest_with_the_penalty_floor_at_zero() {
-    let mut worst_default = Worst::default();
+fn stacked_columns_stand_still() {
+    let mut worst_short_default = Worst::default();
     for layers in [4, 5, 6, 7] {
         for columns in [1, 3] {
             for dt in [0.01, 0.002] {
@@ -444,22 +443,21 @@ fn stacked_columns_come_to_rest_with_the_penalty_floor_at_zero() {
                     "{case}: largest speed in the last second {zero:.2e} m/s at floor 0, \
                      {default:.2e} m/s at 0.01"
                 );
-                worst_default.update(default, &case);
-                assert!(
-                    zero < 0.2 * default,
-                    "{case}: {zero:.3e} against {default:.3e} m/s"
-                );
-                if columns == 1 && dt == 0.01 {
-                    assert!(zero < 1e-6, "{case}: {zero:.3e} m/s at floor 0");
+                assert!(zero < 1e-6, "{case}: {zero:.3e} m/s at floor 0");
+                if dt == 0.01 {
+                    assert!(default < 1e-6, "{case}: {default:.3e} m/s at floor 0.01");
+                } else {
+                    worst_short_default.update(default, &case);
                 }
             }
         }
     }
-    // If this fails, the default no longer rocks a stack: update penalty_floor's documentation.
+    // If this fails, the default floor no longer rocks a stack at short steps: update
+    // penalty_floor's documentation and the README.
     assert!(
-        worst_default.0 > 1e-3,
+        worst_short_default.0 > 1e-4,
         "{:.3e} m/s ({})",
-        worst_default.0,
-        worst_default.1
+        worst_short_default.0,
+        worst_short_default.1
     );
 }

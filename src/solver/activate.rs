@@ -156,6 +156,12 @@ fn activate_one(
     }
     let unseen = old.is_none_or(|r| r.state == ContactState::Open);
     keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen, w0);
+    // The force the last step ended with (its λ carries less: `commit::commit_contact`).
+    let friction_normal = if old.is_some() && p.contact.warm_start && p.method == Method::Alm {
+        rec.normal_force.max(0.0)
+    } else {
+        rec.lambda
+    };
     let active = Active {
         joint: joint_set(&cand.key, bi, bj),
         kin,
@@ -170,6 +176,8 @@ fn activate_one(
         dn: 0.0,
         force: 0.0,
         dn_prev: None,
+        friction_normal,
+        lambda_solved: None,
         friction_cap: None,
         flips: 0,
         frozen: false,

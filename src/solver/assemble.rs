@@ -494,6 +494,7 @@ mod tests {
             };
             c.rec.penalty *= [1.0, 10.0, 100.0][n % 3];
             c.rec.lambda = 1e4;
+            c.friction_normal = 1e4;
             c.rec.tau = c
                 .cand
                 .normal

@@ -107,6 +107,20 @@ fn commit_contact(
             0.0
         },
     });
+    // The warm start (reference §6.2) carries the multiplier the accepted solution was solved
+    // with, λ_{k−1}, not λ_k = λ_{k−1} + p_n d_n (P1). The force of the next step's first solve,
+    // λ + p_n d_n, then starts from the force this step ended with. Carrying λ_k counted the
+    // penetration left at the step's end twice, once in λ_k and again in d_n, so wherever the
+    // loop stopped before d_n reached zero the carried force was an integral of the penetration
+    // over the steps and lagged the motion: a column of four blocks on a fixed one rocked at
+    // 2.7 mm/s for as long as a run lasted, a generated wall of 1000 at up to 7 mm/s
+    // (`tests/stable_dynamics.rs`, the stacked columns). A model of one block on one contact,
+    // scripted apart, shows the same: its motion grew without bound at p_n ≪ m/Δt² with λ_k
+    // carried, and died out at every p_n with λ_{k−1}. The loop's own iterations still update
+    // λ as (P1) has it, and friction takes the force, not this λ ([`Active::friction_normal`]).
+    if closed && let Some(lambda) = c.lambda_solved {
+        rec.lambda = lambda;
+    }
     (c.cand.key, rec, snap)
 }
 

@@ -16,8 +16,14 @@ use crate::params::SolverParams;
 use crate::params::step_rules::SETTLE_FRACTION;
 use crate::physics::geometry::Vec3;
 
-/// State changes a contact may make in one attempt before it is settled.
-const MAX_FLIPS: u8 = 2;
+/// State changes a contact may make in one attempt before it is settled. Settling is the last
+/// resort against a cycle, and it has a price: a contact settled locked holds whatever shear
+/// its spring has for the rest of the attempt, beyond its Mohr–Coulomb strength too. At 2 the
+/// shipped jointed slope settled 8659 contacts in its first second, and locked contacts on J1
+/// (φ 25°) held up to 20 kN of shear on 0.7 kN of normal force: its free blocks travelled a
+/// median 0.835 m by 1 s (the least 0.63 m) against Coulomb's 0.95 m. At 6 it settled 2990,
+/// and they travelled 0.938 m (the least 0.91 m), with fewer passes and solves.
+const MAX_FLIPS: u8 = 6;
 
 /// What the check of one pass reads.
 pub(crate) struct CheckInputs<'a> {
@@ -152,6 +158,7 @@ fn apply(inp: &CheckInputs, c: &mut Active, verdict: Transition, shear: Vec3) {
         Transition::Open => {
             c.rec.state = ContactState::Open;
             c.rec.lambda = 0.0;
+            c.friction_normal = 0.0;
             c.rec.intact = false;
         }
         Transition::Slide { tau } => {
@@ -197,6 +204,7 @@ fn close(inp: &CheckInputs, c: &mut Active) {
     c.rec.state = ContactState::Lock;
     c.rec.reference = c.cand.xb;
     c.rec.lambda = 0.0;
+    c.friction_normal = 0.0;
     // A new contact starts at p_n,1 (§6.1). One that was closed at the start of the
     // step and only opened in an earlier pass is not new: it keeps its adapted penalty,
     // which spares the (P21) rounds, and their factorizations, of raising it again.
