@@ -504,8 +504,10 @@ fn cross_cut_stacks_with_friction_above_their_dip_stand() {
 
 /// A 5 m wide slice of the shipped `scenes/jointed_slope.toml`, run for 1 s after its
 /// equilibrium stage: every block of the upper mass above J1's lowest daylighting plane (F =
-/// 0.67) slides out (Coulomb's 1.9 m/s² gives 0.95 m; those behind lag), and every other block
-/// stands, within 1 cm. Before the contacts of acute joint edges were read right (a vertex
+/// 0.67) slides out as Coulomb's 1.9 m/s² has it (0.95 m), and every other block stands, within
+/// 3 mm. While a contact that changed state three times in a step was settled, locked contacts
+/// held shear beyond their strength and the free blocks lagged: the least moved 0.475 m, the
+/// median 0.547 m (9.3 cm and 22 cm before friction turned by the trial force). Before the contacts of acute joint edges were read right (a vertex
 /// beside an acute edge taken as 6 cm deep, crossed edges near their ends as 5 cm deep) and
 /// the stick update's shear was capped, this slice diverged at 0.8 s, its upper face blocks
 /// thrown out at 50 m/s; with only the first of those, a block fell through the rock under it.
@@ -546,7 +548,7 @@ fn a_slice_of_the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
             free.push(moved);
         } else {
             most_other = most_other.max(moved);
-            assert!(moved < 0.01, "{name} moved {moved} m");
+            assert!(moved < 0.003, "{name} moved {moved} m");
         }
     }
     free.sort_by(f64::total_cmp);
@@ -555,14 +557,12 @@ fn a_slice_of_the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
         "{} free blocks moved {least:.3} m or more (median {median:.3} m), the others {most_other:.4} m or less",
         free.len()
     );
-    // The free blocks behind the face push on those in front and lag them: at least 3 cm each
-    // (15 times the most any other block moves), half of them more than 10 cm.
     assert!(free.len() >= 10, "{} free blocks", free.len());
-    // Coulomb's motion gives 0.95 m; the blocks behind the face slabs lag them (measured: the
-    // least-moved 9.3 cm, the median 22 cm).
-    assert!(least > 0.03, "a free block moved {least} m");
+    // Coulomb's motion gives 0.95 m (measured: the least-moved 0.919 m, the median 0.948 m,
+    // the others 0.7 mm or less).
+    assert!(least > 0.85, "a free block moved {least} m");
     assert!(
-        median > 0.1,
+        (0.9..1.0).contains(&median),
         "half the free blocks moved {median} m or less"
     );
 }

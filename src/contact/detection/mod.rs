@@ -422,6 +422,19 @@ fn edge_edge(
     }
 }
 
+/// Two candidates of one block pair at one place whose normals oppose (an angle beyond 90°):
+/// two convex blocks touching there have one separating direction, and the pair would clamp
+/// them. At the acute edges of a jointed slope two edge–edge contacts of lower/41 and
+/// upper/137 met at one point of the slower block's edge, normals 140° apart, one of them
+/// 6 cm deep; their multipliers pressed the blocks together with 2–3·10⁸ N each, which
+/// grew step by step, and when one of them let go the block left at 24 m/s. "One place":
+/// their points on block j closer than the deeper one's depth (or the merge distance). The
+/// one kept is the one the de-duplication prefers (known, then the larger gap).
+fn opposed(k: &Candidate, c: &Candidate, p: &DetectionParams) -> bool {
+    let reach = p.merge_distance.max(-k.gap).max(-c.gap);
+    k.normal.dot(&c.normal) < 0.0 && (k.xb - c.xb).norm() <= reach
+}
+
 /// All contacts of one block pair, de-duplicated: candidates whose contact points coincide are
 /// one physical constraint (typically the i→j and j→i vertex–face contacts at the corners of two
 /// equal stacked faces). `known` tells which keys existed in the previous step: those win, so a
@@ -450,7 +463,7 @@ pub fn detect_pair(
         let mid = (c.xa + c.xb) / 2.0;
         if kept
             .iter()
-            .all(|k| ((k.xa + k.xb) / 2.0 - mid).norm() > p.merge_distance)
+            .all(|k| ((k.xa + k.xb) / 2.0 - mid).norm() > p.merge_distance && !opposed(k, &c, p))
         {
             kept.push(c);
         }
