@@ -312,3 +312,55 @@ fn a_vertex_just_past_a_face_edge_is_taken_on_the_face_that_separates_it() {
     let f = beside(Vec3::new(0.5, -0.02, 1.0), 0.02).expect("the side face");
     assert!((f.normal + Vec3::y()).norm() < 1e-12 && (f.gap - 0.02).abs() < 1e-12);
 }
+
+/// One candidate at `xb` with this normal and gap (an edge–edge key of its own).
+fn candidate_at(xb: Vec3, normal: Vec3, gap: f64, feature: u32) -> Candidate {
+    Candidate {
+        key: ContactKey {
+            i: 0,
+            j: 1,
+            mode: 1,
+            feature_i: feature,
+            feature_j: feature,
+        },
+        points: [xb; 4],
+        normal,
+        gap,
+        xa: xb + normal * gap,
+        xb,
+        alternatives: Vec::new(),
+        tied: false,
+    }
+}
+
+#[test]
+fn opposed_normals_at_one_place_are_one_contact() {
+    let p = params();
+    let at = Vec3::new(3.0, 2.0, 5.0);
+    let n1 = Vec3::new(0.86, 0.0, -0.51).normalize();
+    let n2 = Vec3::new(-0.98, 0.02, -0.18).normalize();
+    let shallow = candidate_at(at, n1, -1e-9, 0);
+    // The slope's pair: 140° apart, one 6 cm deep, at one point of block j.
+    let deep = candidate_at(at, n2, -0.06, 1);
+    assert!(opposed(&shallow, &deep, &p));
+    assert!(opposed(&deep, &shallow, &p));
+    // Within the deeper one's depth of each other: still one place.
+    let near = candidate_at(at + Vec3::new(0.0, 0.05, 0.0), n2, -0.06, 1);
+    assert!(opposed(&shallow, &near, &p));
+    // Farther apart than the depth: two places, both kept.
+    let far = candidate_at(at + Vec3::new(0.0, 0.1, 0.0), n2, -0.06, 1);
+    assert!(!opposed(&shallow, &far, &p));
+    // At one place but less than 90° apart (a vertex at a right-angled edge): both kept.
+    let square = candidate_at(at, Vec3::x(), -1e-9, 1);
+    assert!(!opposed(
+        &candidate_at(at, Vec3::z(), -1e-9, 0),
+        &square,
+        &p
+    ));
+    // 80° apart: both kept; 100° apart: one.
+    let up = candidate_at(at, Vec3::z(), -1e-9, 0);
+    let at_80 = candidate_at(at, Vec3::new(-0.985, 0.0, 0.174).normalize(), -1e-9, 1);
+    assert!(!opposed(&up, &at_80, &p));
+    let at_100 = candidate_at(at, Vec3::new(-0.985, 0.0, -0.174).normalize(), -1e-9, 1);
+    assert!(opposed(&up, &at_100, &p));
+}
