@@ -507,8 +507,9 @@ fn cross_cut_stacks_with_friction_above_their_dip_stand() {
 /// 0.67) slides out as Coulomb's 1.9 m/s² has it (0.95 m), and every other block stands, within
 /// 3 mm. While a contact that changed state three times in a step was settled, locked contacts
 /// held shear beyond their strength and the free blocks lagged: the least moved 0.475 m, the
-/// median 0.547 m (9.3 cm and 22 cm before friction turned by the trial force). Before the contacts of acute joint edges were read right (a vertex
-/// beside an acute edge taken as 6 cm deep, crossed edges near their ends as 5 cm deep) and
+/// median 0.547 m (9.3 cm and 22 cm before friction turned by the trial force). Before the
+/// contacts of acute joint edges were read right (a vertex beside an acute edge taken as 6 cm
+/// deep, crossed edges near their ends as 5 cm deep) and
 /// the stick update's shear was capped, this slice diverged at 0.8 s, its upper face blocks
 /// thrown out at 50 m/s; with only the first of those, a block fell through the rock under it.
 #[test]

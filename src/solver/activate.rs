@@ -156,11 +156,12 @@ fn activate_one(
     }
     let unseen = old.is_none_or(|r| r.state == ContactState::Open);
     keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen, w0);
-    // The force the last step ended with (its λ carries less: `commit::commit_contact`).
-    let friction_normal = if old.is_some() && p.contact.warm_start && p.method == Method::Alm {
+    // The force the last step ended with (its λ carries less: `commit::commit_contact`); a
+    // new record's is 0, as is every λ without the warm start.
+    let friction_normal = if p.contact.warm_start && p.method == Method::Alm {
         rec.normal_force.max(0.0)
     } else {
-        rec.lambda
+        0.0
     };
     let active = Active {
         joint: joint_set(&cand.key, bi, bj),

@@ -162,8 +162,7 @@ impl Active {
         match law::settle(self.rec.state, self.dn, close_tol) {
             Settled::Open => {
                 self.rec.state = ContactState::Open;
-                self.rec.lambda = 0.0;
-                self.friction_normal = 0.0;
+                self.clear_normal_force();
             }
             // A sliding contact settled locked keeps its friction, as one that sticks does: a
             // fresh spring dropped it, and a block whose corner sat at its friction limit,
@@ -193,10 +192,17 @@ impl Active {
     fn release_tension(&mut self, p: &SolverParams) {
         if self.rec.penalty > p.contact.initial_penalty {
             self.set_penalty(p.contact.initial_penalty, &p.contact);
-            self.rec.lambda = 0.0;
-            self.friction_normal = 0.0;
-            self.lambda_solved = None;
+            self.clear_normal_force();
         }
+    }
+
+    /// Drops the contact's normal force: its multiplier λ, the force its friction takes and
+    /// the multiplier it would carry into the next step (a contact that opens, closes afresh,
+    /// or lets go of a tension it cannot hold).
+    pub fn clear_normal_force(&mut self) {
+        self.rec.lambda = 0.0;
+        self.friction_normal = 0.0;
+        self.lambda_solved = None;
     }
 
     /// Sets p_n, keeping the shear spring's force: its stiffness p_τ is proportional to p_n, so

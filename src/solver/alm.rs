@@ -256,9 +256,10 @@ fn update_multipliers(
     // centimetres a second; with the floor at 0, (P21) stiffens its contacts and it stays
     // still (`penalty_floor`'s table entry, `tests/stable_dynamics.rs`). Nor for a closed
     // contact the solve pulls apart (d_n < 0): a stiffer penalty only lets it hold more
-    // tension, and the open–close check, not the penalty, deals with it. Slabs sliding together rock on their joints
-    // by micrometres; raised there a hundredfold, the penalties swung their forces by
-    // 10⁵ N and the iteration settled on states that stopped the slabs within a step.
+    // tension, and the open–close check, not the penalty, deals with it. Slabs sliding
+    // together rock on their joints by micrometres; raised there a hundredfold, the penalties
+    // swung their forces by 10⁵ N and the iteration settled on states that stopped the slabs
+    // within a step.
     if let Some(prev) = c.dn_prev
         && alm_k <= PENALTY_ROUNDS + 1
         && !converged

@@ -166,8 +166,7 @@ fn apply(inp: &CheckInputs, c: &mut Active, verdict: Transition, shear: Vec3) {
         }
         Transition::Open => {
             c.rec.state = ContactState::Open;
-            c.rec.lambda = 0.0;
-            c.friction_normal = 0.0;
+            c.clear_normal_force();
             c.rec.intact = false;
         }
         Transition::Slide { tau } => {
@@ -212,8 +211,7 @@ fn close(inp: &CheckInputs, c: &mut Active) {
     let cp = &inp.params.contact;
     c.rec.state = ContactState::Lock;
     c.rec.reference = c.cand.xb;
-    c.rec.lambda = 0.0;
-    c.friction_normal = 0.0;
+    c.clear_normal_force();
     // A new contact starts at p_n,1 (§6.1). One that was closed at the start of the
     // step and only opened in an earlier pass is not new: it keeps its adapted penalty,
     // which spares the (P21) rounds, and their factorizations, of raising it again.
