@@ -33,18 +33,30 @@ pub struct BenchRun {
     /// Wall time of formatting and writing each step's CSV rows (blocks.csv, contacts.csv into a
     /// scratch directory), measured apart from the solver, s; `None` when not measured.
     pub output: Option<f64>,
+    /// The initial equilibrium stage, timed apart (not in `wall`): its steps and wall time, s.
+    pub stage: Option<(u64, f64)>,
 }
 
 /// Runs a scene to its duration, timing the solver only; with `output`, also times writing the
 /// CSV rows of every step (as `run` does, but on this thread, so the cost shows on its own).
+/// The equilibrium stage, if the scene has one, is timed apart and writes no rows.
 pub fn time_run(scene: &Scene, output: bool) -> Result<BenchRun, SolverError> {
     let mut s = Solver::new(scene.model.clone(), scene.params.clone());
     let scratch = std::env::temp_dir().join(format!("dda3d-bench-{}", std::process::id()));
     let mut rows = output.then(|| RowWriter::create(&scratch).ok()).flatten();
     let (mut wall, mut writing) = (0.0, 0.0);
+    let mut stage = s.in_equilibrium_stage().then_some((0u64, 0.0));
     while !s.finished() {
+        let staging = s.in_equilibrium_stage();
         let t = Instant::now();
         s.step()?;
+        if staging {
+            if let Some((steps, time)) = stage.as_mut() {
+                *steps += 1;
+                *time += t.elapsed().as_secs_f64();
+            }
+            continue;
+        }
         wall += t.elapsed().as_secs_f64();
         if let Some(w) = rows.as_mut() {
             let t = Instant::now();
@@ -63,6 +75,7 @@ pub fn time_run(scene: &Scene, output: bool) -> Result<BenchRun, SolverError> {
         simulated: s.time,
         totals: s.totals.clone(),
         output: measured.then_some(writing),
+        stage,
     })
 }
 

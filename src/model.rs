@@ -154,6 +154,16 @@ impl Block {
         0.5 * (v.transpose() * self.mass_matrix * v)[0]
     }
 
+    /// A bound of the speed of its fastest vertex, m/s: the translation's speed plus the
+    /// rotation's and the strain rate's at the block's radius.
+    pub fn peak_speed(&self) -> f64 {
+        let v = &self.velocity;
+        let r = self.radius();
+        Vec3::new(v[0], v[1], v[2]).norm()
+            + Vec3::new(v[3], v[4], v[5]).norm() * r
+            + v.fixed_rows::<6>(6).norm() * r
+    }
+
     /// Largest distance from the centroid to a vertex.
     pub fn radius(&self) -> f64 {
         self.vertices

@@ -363,6 +363,10 @@ pub struct Summary {
     /// Contacts settled after cycling between states within one attempt, or at the open–close
     /// pass limit.
     pub frozen_contacts: u64,
+    /// Steps in which at least one block slept, held still with its island (absent when none
+    /// did; see `solver.sleep_velocity`).
+    #[serde(skip_serializing_if = "is_zero")]
+    pub sleeping_steps: u64,
     /// Seconds spent in each phase.
     pub timings: Timings,
     /// The initial equilibrium stage (`[solver] initial_equilibrium`): its static steps, R_max
@@ -372,6 +376,10 @@ pub struct Summary {
     /// What cutting each rock mass of the scene gave (absent without rock masses).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub rock_masses: Vec<RockMassReport>,
+}
+
+fn is_zero(n: &u64) -> bool {
+    *n == 0
 }
 
 impl Summary {
@@ -397,6 +405,7 @@ impl Summary {
             unconverged_steps: t.unconverged_steps,
             alm_cap_hits: t.alm_cap_hits,
             frozen_contacts: t.frozen_contacts,
+            sleeping_steps: t.sleeping_steps,
             timings: t.timings.clone(),
             equilibrium: None,
             rock_masses: Vec::new(),

@@ -170,6 +170,9 @@ pub struct StepStats {
     pub contacts_slide: u32,
     /// Detected but open contacts.
     pub contacts_open: u32,
+    /// Blocks asleep in this step (held still; see `solver.sleep_velocity`).
+    #[serde(default)]
+    pub blocks_asleep: u32,
     /// Kinetic energy ½ vᵀMv over all blocks, J.
     pub kinetic_energy: f64,
     /// Gravitational potential energy Σ m g·(−x_c) relative to the origin, J.
@@ -250,6 +253,9 @@ pub struct RunTotals {
     /// Contacts settled closed and locked: after cycling between states within one attempt, or
     /// still changing at the open–close pass limit (see `unconverged_steps`).
     pub frozen_contacts: u64,
+    /// Steps in which at least one block slept (see `solver.sleep_velocity`).
+    #[serde(default)]
+    pub sleeping_steps: u64,
     pub contacts_per_step: f64,
     pub timings: Timings,
 }

@@ -57,6 +57,8 @@ fn track(text: &str, duration: f64, set: impl Fn(&mut SolverParams)) -> [[f64; 3
     let mut s = scene::parse(text, "family.toml", "family").expect("scene parses");
     s.params.mode = Mode::Dynamic;
     s.params.duration = duration;
+    // The solver's own stillness: a sleeping block would be held exactly (tests/sleeping.rs).
+    s.params.sleep_velocity = 0.0;
     set(&mut s.params);
     let mut solver = Solver::new(s.model, s.params);
     while solver.in_equilibrium_stage() {
@@ -403,6 +405,8 @@ fn stack_speed(
     let text = dda3d::generate::column_wall(blocks, layers, false);
     let mut s = scene::parse(&text, "stack.toml", "stack").expect("scene parses");
     s.params.duration = duration;
+    // The solver's own stillness, not sleeping's (see `track`).
+    s.params.sleep_velocity = 0.0;
     set(&mut s.params);
     let mut solver = Solver::new(s.model, s.params);
     let mut fastest = 0.0f64;

@@ -225,6 +225,11 @@ pub struct SolverParams {
     pub equilibrium_tolerance: f64,
     /// The stage ends after this many static steps even if R_max has not fallen.
     pub equilibrium_max_steps: u32,
+    /// A block is still while its fastest vertex is slower than this, m/s; 0: no block ever
+    /// sleeps. See [`crate::solver`]'s sleeping islands.
+    pub sleep_velocity: f64,
+    /// An island of blocks sleeps once all of them have been still this long, s.
+    pub sleep_time: f64,
     /// `[solver.contact]`.
     pub contact: ContactParams,
     /// The scene's top-level `[joint]` table (not part of `[solver]`).
@@ -256,6 +261,8 @@ impl Default for SolverParams {
             initial_equilibrium: false,
             equilibrium_tolerance: 1e-5,
             equilibrium_max_steps: 2000,
+            sleep_velocity: 1e-5,
+            sleep_time: 0.1,
             contact: ContactParams::default(),
             joint: JointParams::default(),
             joint_sets: Vec::new(),

@@ -411,7 +411,7 @@ pub fn find(name: &str) -> Option<&'static Param> {
 }
 
 /// Every key, in the scene file's order (`[solver]`, `[solver.contact]`, `[joint]`).
-pub const ALL: [&Param; 28] = [
+pub const ALL: [&Param; 30] = [
     &METHOD,
     &MODE,
     &SPECTRAL_RADIUS,
@@ -425,6 +425,8 @@ pub const ALL: [&Param; 28] = [
     &INITIAL_EQUILIBRIUM,
     &EQUILIBRIUM_TOLERANCE,
     &EQUILIBRIUM_MAX_STEPS,
+    &SLEEP_VELOCITY,
+    &SLEEP_TIME,
     &INITIAL_PENALTY,
     &ALPHA,
     &BETA,

@@ -27,8 +27,6 @@ pub(crate) struct ActivationInputs<'a> {
     pub params: &'a SolverParams,
     pub blocks: &'a [Block],
     pub records: &'a RecordMap,
-    /// Each block's initial bounding box (its group's w0 is measured on those).
-    pub initial_boxes: &'a [(Vec3, Vec3)],
     /// The step about to be taken (0 for the first) and its start time.
     pub step: u64,
     pub time: f64,
@@ -36,27 +34,68 @@ pub(crate) struct ActivationInputs<'a> {
     pub dt: f64,
 }
 
-/// This step's contacts, and the contact groups with their w0 and the block pairs near each
-/// other (the broad phase's pairs, sorted).
-pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
-    let p = inp.params;
-    let shapes: Vec<Shape> = inp
-        .blocks
-        .par_iter()
-        .with_min_len(PAR_BLOCKS)
-        .map(Shape::of)
-        .collect();
-    let bounds = inp
-        .blocks
+/// The broad phase: the contact groups with their w0 and the block pairs near each other
+/// (sorted).
+pub(crate) fn contact_groups(
+    p: &SolverParams,
+    blocks: &[Block],
+    initial_boxes: &[(Vec3, Vec3)],
+) -> ContactGroups {
+    let bounds = blocks
         .iter()
-        .zip(inp.initial_boxes)
+        .zip(initial_boxes)
         .map(|(b, &home)| Bounds::of(b, home))
         .collect();
-    let groups = ContactGroups::find(bounds, p.max_displacement_ratio);
+    ContactGroups::find(bounds, p.max_displacement_ratio)
+}
+
+/// This step's contacts and the contact groups ([`contact_groups`], from each block's
+/// `initial_boxes`), every block awake.
+#[cfg(test)]
+pub(crate) fn activate(
+    inp: &ActivationInputs,
+    initial_boxes: &[(Vec3, Vec3)],
+) -> (Vec<Active>, ContactGroups) {
+    let groups = contact_groups(inp.params, inp.blocks, initial_boxes);
+    let active = activate_awake(inp, &groups, &[]);
+    (active, groups)
+}
+
+/// This step's contacts between the pairs of `groups` of which at least one block is awake
+/// (`asleep[i]` false, or `asleep` empty): two sleeping blocks are not searched.
+pub(crate) fn activate_awake(
+    inp: &ActivationInputs,
+    groups: &ContactGroups,
+    asleep: &[bool],
+) -> Vec<Active> {
+    let p = inp.params;
+    let sleeps = |i: usize| asleep.get(i).copied().unwrap_or(false);
+    let pairs: Vec<(usize, usize)> = groups
+        .pairs
+        .iter()
+        .copied()
+        .filter(|&(a, b)| !(sleeps(a) && sleeps(b)))
+        .collect();
+    let mut needed = vec![asleep.is_empty(); inp.blocks.len()];
+    for &(a, b) in &pairs {
+        needed[a] = true;
+        needed[b] = true;
+    }
+    let shapes: Vec<Option<Shape>> = inp
+        .blocks
+        .par_iter()
+        .zip(&needed)
+        .with_min_len(PAR_BLOCKS)
+        .map(|(b, &n)| n.then(|| Shape::of(b)))
+        .collect();
+    let shape = |i: usize| {
+        shapes[i]
+            .as_ref()
+            .expect("a shape for every searched block")
+    };
     let known = |k: &ContactKey| inp.records.contains_key(k);
     // The narrow phase, pair by pair in parallel; collected in the order of the pairs.
-    let cands: Vec<Candidate> = groups
-        .pairs
+    let cands: Vec<Candidate> = pairs
         .par_iter()
         .with_min_len(PAR_PAIRS)
         .flat_map_iter(|&(a, b)| {
@@ -64,7 +103,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
                 check_crossing_depth: p.method == Method::Alm,
                 ..DetectionParams::new(groups.pair_w0(a, b), p.max_displacement_ratio)
             };
-            detect_pair(a, &shapes[a], b, &shapes[b], &dp, &known)
+            detect_pair(a, shape(a), b, shape(b), &dp, &known)
         })
         .collect();
     // Contact transfer: a vertex that slid onto an adjacent, almost coplanar face of the same
@@ -87,7 +126,7 @@ pub(crate) fn activate(inp: &ActivationInputs) -> (Vec<Active>, ContactGroups) {
     if inp.step == 0 && active.iter().any(|c| p.joint_of(c.joint).cohesion > 0.0) {
         assign_cohesion_areas(&mut active);
     }
-    (active, groups)
+    active
 }
 
 /// One detected contact with its record and frozen kinematics; `w0` is its group's.

@@ -7,7 +7,7 @@ use rayon::prelude::*;
 
 use super::PAR_CONTACTS;
 use super::active::Active;
-use super::assemble::{StiffnessSync, load_vector};
+use super::assemble::{StiffnessSync, hold, load_vector};
 use super::counters::{Counters, Stopwatch};
 use super::step_control::Retry;
 use crate::contact::{ContactState, law};
@@ -32,6 +32,8 @@ pub(crate) struct AlmInputs<'a> {
     pub first_step: bool,
     /// The last pass of a non-converging open–close iteration: no more friction holds.
     pub settling: bool,
+    /// The sleeping blocks, held where they are (empty: none).
+    pub held: &'a [bool],
 }
 
 /// The global system of an attempt: K kept in step with the contacts, and its factorization.
@@ -108,6 +110,7 @@ fn solve(
             .update(sys.kmat, inp.k0, &inp.params.contact, inp.blocks, active);
     }
     let mut f = load_vector(inp.params, inp.blocks, inp.f0, active);
+    hold(sys.kmat, &mut f, inp.held);
     counters.assembly += watch.elapsed();
     if k_dirty {
         let watch = Stopwatch::start();

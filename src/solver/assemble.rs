@@ -46,21 +46,49 @@ pub(crate) fn sparsity_pattern(
     p
 }
 
-/// (K0, F0): the block terms of §3 for a step of length `dt`, fixed for an attempt.
+/// (K0, F0): the block terms of §3 for a step of length `dt`, fixed for an attempt. A `held`
+/// block's are zero: [`hold`] gives it its own equation.
 pub(crate) fn block_terms(
     p: &SolverParams,
     blocks: &[Block],
+    held: &[bool],
     scheme: &Scheme,
     dt: f64,
 ) -> (Vec<Mat12>, Vec<Vec12>) {
     blocks
         .par_iter()
+        .enumerate()
         .with_min_len(PAR_BLOCKS)
-        .map(|b| {
+        .map(|(i, b)| {
+            if held.get(i).copied().unwrap_or(false) {
+                return (Mat12::zeros(), Vec12::zeros());
+            }
             let t = one_block(p, b, scheme, &b.kinematics(), dt);
             (t.k, t.f)
         })
         .unzip()
+}
+
+/// Holds the `held` blocks where they are: each one's equation becomes I·d = 0, and its
+/// coupling to every other block is dropped. A contact between a held block and a free one
+/// then acts on the free one alone, as a contact with an immovable block would; its solution
+/// is exactly 0 for the held block. K's other blocks and F's other rows are untouched, so
+/// [`StiffnessSync`] may go on adding to and taking from them (and from the held blocks'
+/// diagonal, which this resets each time).
+pub(crate) fn hold(kmat: &mut BlockMatrix, f: &mut [f64], held: &[bool]) {
+    if held.is_empty() {
+        return;
+    }
+    for (i, _) in held.iter().enumerate().filter(|(_, h)| **h) {
+        kmat.diag[i] = Mat12::identity();
+        f[12 * i..12 * i + 12].fill(0.0);
+    }
+    let BlockMatrix { pairs, off, .. } = kmat;
+    for (&(a, b), m) in pairs.iter().zip(off.iter_mut()) {
+        if held[a] || held[b] {
+            *m = Mat12::zeros();
+        }
+    }
 }
 
 fn one_block(
@@ -415,15 +443,15 @@ mod tests {
         let mut solver = Solver::new(s.model, s.params);
         let mut active = loop {
             solver.step().unwrap();
-            let (active, _) = activate(&ActivationInputs {
+            let inputs = ActivationInputs {
                 params: &solver.params,
                 blocks: &solver.model.blocks,
                 records: &solver.records,
-                initial_boxes: &solver.initial_boxes,
                 step: solver.step,
                 time: solver.time,
                 dt: solver.dt,
-            });
+            };
+            let (active, _) = activate(&inputs, &solver.initial_boxes);
             let has = |m| active.iter().any(|c| c.cand.mode() == m);
             if solver.time >= 0.25 && has(ContactMode::EdgeEdge) && has(ContactMode::VertexFace) {
                 break active;
@@ -457,7 +485,13 @@ mod tests {
 
     /// K assembled afresh for a step of 0.01 s: the block terms and every closed contact.
     fn assemble_fresh(solver: &Solver, active: &[Active], k: &mut BlockMatrix) {
-        let (k0, _) = block_terms(&solver.params, &solver.model.blocks, &Scheme::SHI, 0.01);
+        let (k0, _) = block_terms(
+            &solver.params,
+            &solver.model.blocks,
+            &[],
+            &Scheme::SHI,
+            0.01,
+        );
         k.diag.copy_from_slice(&k0);
         for c in active {
             if let Some(key) = c.stiffness_key() {

@@ -28,6 +28,8 @@ pub(crate) struct AttemptInputs<'a> {
     pub first_step: bool,
     /// The step is at the Δt floor: stragglers at the pass limit are settled, not redone.
     pub at_floor: bool,
+    /// The sleeping blocks, held where they are (empty: none).
+    pub held: &'a [bool],
 }
 
 /// The solution of one attempt at a step.
@@ -72,7 +74,7 @@ fn open_close_iteration(
     let cp = &p.contact;
     let watch = Stopwatch::start();
     // (K0, F0): the block terms of §3, fixed for the attempt.
-    let (k0, f0) = block_terms(p, inp.blocks, &inp.scheme, inp.dt);
+    let (k0, f0) = block_terms(p, inp.blocks, inp.held, &inp.scheme, inp.dt);
     counters.assembly += watch.elapsed();
     for c in active.iter_mut() {
         c.flips = 0;
@@ -100,6 +102,7 @@ fn open_close_iteration(
             f0: &f0,
             first_step: inp.first_step,
             settling: solved.settled,
+            held: inp.held,
         };
         let mut sys = System {
             kmat,

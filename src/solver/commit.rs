@@ -126,10 +126,11 @@ fn commit_contact(
 
 /// Moves every block by its solution: velocity (3.2) v1 = 2D/Δt − v0 or its generalized-α form
 /// (R4.4), stress and strain, and the vertices and load points by the finite-rotation map (1.3).
+/// A `held` (sleeping) block stays exactly as it is.
 pub(crate) fn commit_blocks(
     p: &SolverParams,
     blocks: &mut [Block],
-    maps: &[StepMap],
+    (maps, held): (&[StepMap], &[bool]),
     d: &[f64],
     dt: f64,
     scheme: &Scheme,
@@ -138,6 +139,7 @@ pub(crate) fn commit_blocks(
         .par_iter_mut()
         .with_min_len(PAR_BLOCKS)
         .enumerate()
+        .filter(|(i, _)| !held.get(*i).copied().unwrap_or(false))
         .for_each(|(i, b)| {
             let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
             b.set_kinematics(scheme.advance(&b.kinematics(), &di, dt));

@@ -22,13 +22,15 @@ mod commit;
 mod counters;
 mod equilibrium;
 mod open_close;
+mod sleep;
 mod step_control;
 pub mod watchdog;
 
-use activate::{ActivationInputs, activate};
+use activate::{ActivationInputs, activate_awake, contact_groups};
 use active::Active;
 use attempt::{AttemptInputs, Solved, attempt};
 use counters::{Counters, Stopwatch, debug_log};
+use sleep::Sleep;
 use step_control::Retry;
 use watchdog::{EnergyWatch, step_gain_limit};
 
@@ -103,6 +105,8 @@ pub struct Solver {
     accelerations: bool,
     /// The energy balance since the start of the run (after the equilibrium stage).
     energy: Option<EnergyWatch>,
+    /// Which blocks sleep, and how long each has been still ([`sleep`]).
+    sleep: Sleep,
 }
 
 impl Solver {
@@ -116,6 +120,7 @@ impl Solver {
             .collect();
         let w0 = ContactGroups::find(bounds, params.max_displacement_ratio).largest_w0();
         let mut model = model;
+        let sleep = Sleep::new(model.blocks.len());
         let stage = params
             .initial_equilibrium
             .then(|| equilibrium::Stage::begin(&mut model.blocks, params.equilibrium_tolerance));
@@ -141,6 +146,7 @@ impl Solver {
             equilibrium: None,
             accelerations: false,
             energy,
+            sleep,
         }
     }
 
@@ -214,14 +220,15 @@ impl Solver {
         if debug_log() {
             let l = &self.last;
             eprintln!(
-                "step t={:.4} dt={dt:.2e} kinetic={:.4e} potential={:.6e} elastic={:.4e} gain={:.3e} passes={} factorizations={}",
+                "step t={:.4} dt={dt:.2e} kinetic={:.4e} potential={:.6e} elastic={:.4e} gain={:.3e} passes={} factorizations={} asleep={}",
                 self.time,
                 l.kinetic_energy,
                 l.potential_energy,
                 l.elastic_energy,
                 energy.as_ref().map_or(0.0, |e| e.0),
                 l.open_close_iterations,
-                l.factorizations
+                l.factorizations,
+                l.blocks_asleep
             );
         }
         if let Some((_, Err(reason))) = energy {
@@ -323,61 +330,179 @@ impl Solver {
                 b.set_kinematics(Kinematics::at_rest());
             }
         }
-        let (mut active, mut kmat, groups) = self.detect();
+        let groups = contact_groups(&self.params, &self.model.blocks, &self.initial_boxes);
+        self.w0 = groups.largest_w0();
+        self.settle_sleep(&groups);
         let predicted = step_control::predict_dt(&self.params, &self.model.blocks, &groups);
-        self.totals.timings.detection += watch.seconds();
-
         let base = self.dt.min(predicted);
         let first = step_control::first_attempt(base, room);
+        if self.sleep.all_asleep() && !self.model.blocks.is_empty() {
+            self.totals.timings.detection += watch.seconds();
+            return Ok((self.rest(first, base), false));
+        }
+        // The sleeping blocks, held where they are (none: empty).
+        let held = if self.sleep.any_asleep() {
+            self.sleep.asleep().to_vec()
+        } else {
+            Vec::new()
+        };
+        let (mut active, mut kmat) = self.detect(&groups, &held);
+        self.totals.timings.detection += watch.seconds();
+
         let (solved, dt, cuts, factorizations) =
-            self.solve(&mut kmat, &mut active, &groups, first)?;
+            self.solve(&mut kmat, &mut active, &groups, &held, first)?;
         self.linear.matrix = Some(kmat);
 
         let watch = Stopwatch::start();
         let maps = commit::step_maps(&self.model.blocks, &solved.d);
-        let (records, contacts) = commit::commit_contacts(&self.params, &maps, &active);
+        let (mut records, mut contacts) = commit::commit_contacts(&self.params, &maps, &active);
+        let mut stats = StepStats {
+            time_step: dt,
+            open_close_iterations: solved.oc_passes,
+            alm_iterations: solved.solves,
+            time_step_cuts: cuts,
+            factorizations,
+            ..commit::contact_stats(&active, &contacts)
+        };
+        if !held.is_empty() {
+            self.carry_sleeping(&held, &mut records, &mut contacts, &mut stats);
+        }
         self.records = records;
         self.contacts = contacts;
         let scheme = self.scheme();
         commit::commit_blocks(
             &self.params,
             &mut self.model.blocks,
-            &maps,
+            (&maps, &held),
             &solved.d,
             dt,
             &scheme,
         );
         self.accelerations = self.params.mode == Mode::Dynamic;
+        if self.sleeping() {
+            let fixed: Vec<bool> = self.model.blocks.iter().map(|b| b.fixed).collect();
+            let speeds: Vec<f64> = self.model.blocks.iter().map(|b| b.peak_speed()).collect();
+            self.sleep
+                .record(&fixed, &speeds, dt, self.params.sleep_velocity);
+        }
         self.totals.timings.bookkeeping += watch.seconds();
 
-        let stats = StepStats {
-            time_step: dt,
-            open_close_iterations: solved.oc_passes,
-            alm_iterations: solved.solves,
-            time_step_cuts: cuts,
-            factorizations,
-            ..commit::contact_stats(&active, &self.contacts)
-        };
         self.count(&stats, active.len());
         self.last = commit::with_energy(stats, &self.model.blocks, self.params.gravity);
         self.dt = step_control::next_dt(&self.params, base, dt, cuts);
         Ok((dt, solved.settled))
     }
 
-    /// Stage 1: this step's contacts, the global matrix laid out on their pattern, and the
-    /// contact groups with their w0.
-    fn detect(&mut self) -> (Vec<Active>, BlockMatrix, ContactGroups) {
-        let (mut active, groups) = activate(&ActivationInputs {
-            params: &self.params,
-            blocks: &self.model.blocks,
-            records: &self.records,
-            initial_boxes: &self.initial_boxes,
-            step: self.step,
-            time: self.time,
-            dt: self.dt,
-        });
-        self.w0 = groups.largest_w0();
-        let pairs = assemble::sparsity_pattern(&active, &self.linear.pattern, &groups.pairs);
+    /// Whether blocks may sleep now: in a dynamic run with a sleep velocity, after the
+    /// equilibrium stage (which brings the model to rest by its own measure).
+    fn sleeping(&self) -> bool {
+        self.stage.is_none()
+            && self.params.mode == Mode::Dynamic
+            && self.params.sleep_velocity > 0.0
+    }
+
+    /// Decides which blocks sleep in the coming step ([`sleep`]), and stops those that fall
+    /// asleep now (each slower than the sleep velocity).
+    fn settle_sleep(&mut self, groups: &ContactGroups) {
+        if !self.sleeping() {
+            if self.sleep.any_asleep() {
+                self.sleep.wake_all();
+            }
+            return;
+        }
+        let fixed: Vec<bool> = self.model.blocks.iter().map(|b| b.fixed).collect();
+        for i in self
+            .sleep
+            .settle(&fixed, &groups.pairs, self.params.sleep_time)
+        {
+            self.model.blocks[i].set_kinematics(Kinematics::at_rest());
+        }
+    }
+
+    /// Wakes every block: after the parameters, loads or blocks were changed from outside the
+    /// solver (the viewer's panel).
+    pub fn wake_all(&mut self) {
+        self.sleep.wake_all();
+    }
+
+    /// Whether block `i` sleeps.
+    pub fn is_asleep(&self, i: usize) -> bool {
+        self.sleep.is_asleep(i)
+    }
+
+    /// The records and closed contacts of pairs of sleeping blocks, carried unchanged from the
+    /// last step into this one's (no contact of theirs was searched), and counted in `stats`.
+    fn carry_sleeping(
+        &self,
+        held: &[bool],
+        records: &mut RecordMap,
+        contacts: &mut Vec<ContactSnapshot>,
+        stats: &mut StepStats,
+    ) {
+        for (k, r) in &self.records {
+            if held[k.i as usize] && held[k.j as usize] {
+                records.insert(*k, *r);
+            }
+        }
+        for c in &self.contacts {
+            if held[c.block_i] && held[c.block_j] {
+                contacts.push(c.clone());
+                match c.state {
+                    crate::contact::ContactState::Lock => stats.contacts_lock += 1,
+                    crate::contact::ContactState::Slide => stats.contacts_slide += 1,
+                    crate::contact::ContactState::Open => {}
+                }
+            }
+        }
+        stats.blocks_asleep = held.iter().filter(|&&h| h).count() as u32;
+    }
+
+    /// A step in which every block sleeps: nothing moves, the contacts keep their records and
+    /// forces. Returns the step taken.
+    fn rest(&mut self, dt: f64, base: f64) -> f64 {
+        let count = |s| self.contacts.iter().filter(|c| c.state == s).count() as u32;
+        let stats = StepStats {
+            time_step: dt,
+            contacts_lock: count(crate::contact::ContactState::Lock),
+            contacts_slide: count(crate::contact::ContactState::Slide),
+            blocks_asleep: self.model.blocks.len() as u32,
+            ..Default::default()
+        };
+        self.count(&stats, 0);
+        self.last = commit::with_energy(stats, &self.model.blocks, self.params.gravity);
+        self.dt = step_control::next_dt(&self.params, base, dt, 0);
+        dt
+    }
+
+    /// Stage 1: this step's contacts (none between two `held` blocks), and the global matrix
+    /// laid out on their pattern.
+    fn detect(&mut self, groups: &ContactGroups, held: &[bool]) -> (Vec<Active>, BlockMatrix) {
+        let mut active = activate_awake(
+            &ActivationInputs {
+                params: &self.params,
+                blocks: &self.model.blocks,
+                records: &self.records,
+                step: self.step,
+                time: self.time,
+                dt: self.dt,
+            },
+            groups,
+            held,
+        );
+        // Pairs of two sleeping blocks leave the pattern: they hold no contact.
+        let awake_near: Vec<(usize, usize)>;
+        let near: &[(usize, usize)] = if held.is_empty() {
+            &groups.pairs
+        } else {
+            awake_near = groups
+                .pairs
+                .iter()
+                .copied()
+                .filter(|&(a, b)| !(held[a] && held[b]))
+                .collect();
+            &awake_near
+        };
+        let pairs = assemble::sparsity_pattern(&active, &self.linear.pattern, near);
         let n = self.model.blocks.len();
         let kmat = match self.linear.matrix.take() {
             Some(k) if pairs == self.linear.pattern && k.diag.len() == n => k,
@@ -390,7 +515,7 @@ impl Solver {
                 .pair_index(i, j)
                 .expect("pattern holds every contact pair");
         }
-        (active, kmat, groups)
+        (active, kmat)
     }
 
     /// Stages 2–4: attempts at the step from Δt = `first`, cut after each failure, until one
@@ -400,6 +525,7 @@ impl Solver {
         kmat: &mut BlockMatrix,
         active: &mut [Active],
         groups: &ContactGroups,
+        held: &[bool],
         first: f64,
     ) -> Result<(Solved, f64, u32, u32), SolverError> {
         let floor = step_control::dt_floor(&self.params);
@@ -418,6 +544,7 @@ impl Solver {
                 scheme,
                 first_step: self.step == 0,
                 at_floor,
+                held,
             };
             let result = attempt(&inputs, kmat, &mut self.linear.chol, active, &mut counters)
                 .and_then(|solved| {
@@ -472,6 +599,7 @@ impl Solver {
         t.alm_iterations += s.alm_iterations as u64;
         t.time_step_cuts += s.time_step_cuts as u64;
         t.factorizations += s.factorizations as u64;
+        t.sleeping_steps += (s.blocks_asleep > 0) as u64;
         t.symbolic_analyses = self.linear.chol.symbolic_count;
         t.max_penetration = t.max_penetration.max(s.max_penetration);
         t.max_overlap = t.max_overlap.max(s.max_overlap);

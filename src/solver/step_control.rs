@@ -122,11 +122,7 @@ pub(crate) fn predict_dt(p: &SolverParams, blocks: &[Block], groups: &ContactGro
         (-speed + (speed * speed + 2.0 * a * allowed).sqrt()) / a
     };
     for (i, b) in blocks.iter().enumerate().filter(|(_, b)| !b.fixed) {
-        let v = &b.velocity;
-        let r = b.radius();
-        let speed = Vec3::new(v[0], v[1], v[2]).norm()
-            + Vec3::new(v[3], v[4], v[5]).norm() * r
-            + v.fixed_rows::<6>(6).norm() * r;
+        let speed = b.peak_speed();
         if limit(speed, groups.max_w0(i)) < dt {
             let motion = speed * dt_max + 0.5 * a * dt_max * dt_max;
             if let Some(w0) = groups.w0_near(i, motion) {

@@ -206,3 +206,36 @@ pub const EQUILIBRIUM_MAX_STEPS: Param = Param {
           has not settled by then has a mechanism (a block that slides), not a slow start.",
     widget: None,
 };
+
+pub const SLEEP_VELOCITY: Param = Param {
+    key: "solver.sleep_velocity",
+    label: "v_sleep",
+    unit: "m/s",
+    doc: "A block is still while its fastest vertex moves slower than this. An island of blocks \
+          (blocks within contact search distance of each other, fixed blocks not linking them) \
+          sleeps once all its blocks have been still for sleep_time: it is held exactly where \
+          it is, its contacts keep their forces, and it costs nothing until a moving block comes \
+          within search distance of it. A block accelerating from rest at a is stopped only if \
+          a · sleep_time < sleep_velocity (10⁻⁴ m/s² at the defaults). 0: no block ever sleeps.",
+    default: Value::Real(1e-5),
+    get: |p| Value::Real(p.sleep_velocity),
+    set: |p, text| assign(text, &mut p.sleep_velocity),
+    valid: Interval::new(Bound::Closed(0.0), Bound::Closed(0.01)),
+    valid_why: "1 cm/s is a block in motion, not one at rest.",
+    widget: absolute(1e-7, 1e-3, true),
+};
+
+pub const SLEEP_TIME: Param = Param {
+    key: "solver.sleep_time",
+    label: "t_sleep",
+    unit: "s",
+    doc: "How long every block of an island must have been still (see sleep_velocity) before \
+          the island sleeps. Longer: only blocks settled for longer sleep, and a slowly \
+          accelerating block is told apart from one at rest down to a smaller acceleration.",
+    default: Value::Real(0.1),
+    get: |p| Value::Real(p.sleep_time),
+    set: |p, text| assign(text, &mut p.sleep_time),
+    valid: Interval::new(Bound::Open(0.0), Bound::Unbounded),
+    valid_why: "",
+    widget: absolute(0.01, 10.0, true),
+};

@@ -1,7 +1,7 @@
 //! Checkpoints: the complete state of a [`Solver`] in a file, from which a run goes on exactly as
 //! if it had never stopped (`dda3d run --checkpoint-every T`, `dda3d run --resume FILE`).
 //!
-//! # Format (version 1)
+//! # Format (version 2)
 //!
 //! All integers of the header are little-endian.
 //!
@@ -23,7 +23,8 @@
 //! sparsity pattern with the count of symbolic analyses, the closed contacts of the last step,
 //! the last step's statistics, the run's totals (without the wall-clock timings), the
 //! equilibrium stage (if under way) and its report, whether the blocks carry accelerations, and
-//! the energy watch. Sorting the records and encoding nothing that depends on memory addresses,
+//! the energy watch, and each block's still time and whether it sleeps (version 2; version 1
+//! had no sleeping blocks and the two sleep parameters). Sorting the records and encoding nothing that depends on memory addresses,
 //! hash order or the clock makes the same state give the same bytes in every process.
 //!
 //! What a block derives from its vertices and the factorization are recomputed on loading (see
@@ -50,7 +51,7 @@ use super::Solver;
 /// The first bytes of every checkpoint.
 pub const MAGIC: &[u8; 16] = b"DDA3D-CHECKPOINT";
 /// The layout this build writes and the only one it reads.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 /// The extension of checkpoint files.
 pub const EXTENSION: &str = "ckpt";
 /// Magic, version, payload length and checksum.
@@ -179,7 +180,7 @@ mod tests {
         let mut records: Vec<_> = s.records.iter().collect();
         records.sort_by_key(|(k, _)| **k);
         format!(
-            "{:?}\n{:?}\n{:?}\n{} {} {}\n{:?}\n{:?}",
+            "{:?}\n{:?}\n{:?}\n{} {} {}\n{:?}\n{:?}\n{:?}",
             s.snapshot(),
             s.model.blocks,
             records,
@@ -187,7 +188,8 @@ mod tests {
             s.w0,
             s.accelerations,
             s.linear.pattern,
-            s.energy
+            s.energy,
+            s.sleep
         )
     }
 
@@ -209,6 +211,54 @@ mod tests {
         steps(&mut b, 30);
         assert_eq!(fingerprint(&a), fingerprint(&b));
         assert_eq!(a.totals.steps, b.totals.steps);
+    }
+
+    /// A column that has fallen asleep is restored asleep, with its still time, and wakes
+    /// with the original when the rock dropped on it comes near.
+    #[test]
+    fn a_sleeping_column_is_restored_asleep() {
+        let text = r#"
+[solver]
+duration = 2.0
+[materials.rock]
+density = 2750.0
+young_modulus = 2.0e10
+poisson_ratio = 0.25
+[[blocks]]
+name = "ground"
+material = "rock"
+fixed = true
+box = { size = [8, 8, 1], center = [0, 0, -0.5] }
+[[blocks]]
+name = "lower"
+material = "rock"
+box = { size = [1.2, 1.2, 2], center = [0, 0, 1] }
+[[blocks]]
+name = "upper"
+material = "rock"
+box = { size = [1.2, 1.2, 2], center = [0, 0, 3] }
+[[blocks]]
+name = "rock"
+material = "rock"
+box = { size = [0.8, 0.8, 0.8], center = [0, 0, 9] }
+"#;
+        let s = scene::parse(text, "column.toml", "column").unwrap();
+        let mut a = Solver::new(s.model, s.params);
+        while !a.is_asleep(1) {
+            a.step().unwrap();
+            assert!(a.time < 0.8, "the column sleeps before the rock comes near");
+        }
+        let mut b = decode(&encode(&a)).unwrap();
+        assert!(b.is_asleep(1) && b.is_asleep(2) && !b.is_asleep(3));
+        assert_eq!(fingerprint(&a), fingerprint(&b));
+        let mut woken = false;
+        while a.time < 1.5 {
+            a.step().unwrap();
+            b.step().unwrap();
+            woken |= !a.is_asleep(1);
+        }
+        assert!(woken, "the rock wakes the column");
+        assert_eq!(fingerprint(&a), fingerprint(&b));
     }
 
     /// A restored solver's records live in a new `HashMap`, iterated in another order: the bytes

@@ -16,6 +16,7 @@ use std::sync::Arc;
 use serde::{Deserialize, Serialize};
 
 use super::super::equilibrium::{Phase, Stage};
+use super::super::sleep::Sleep;
 use super::super::watchdog::EnergyWatch;
 use super::super::{LinearCache, Solver};
 use crate::contact::ContactKey;
@@ -59,6 +60,9 @@ pub(super) struct SavedSolver {
     equilibrium: Option<EquilibriumReport>,
     accelerations: bool,
     energy: Option<EnergyWatch>,
+    /// Each block's still time, s, and whether it sleeps.
+    still: Vec<f64>,
+    asleep: Vec<bool>,
 }
 
 /// [`SolverParams`] with every field, the ones a scene file does not hold too (its own serde
@@ -78,6 +82,8 @@ struct SavedParams {
     initial_equilibrium: bool,
     equilibrium_tolerance: f64,
     equilibrium_max_steps: u32,
+    sleep_velocity: f64,
+    sleep_time: f64,
     contact: ContactParams,
     joint: JointParams,
     joint_sets: Vec<JointSetParams>,
@@ -173,6 +179,7 @@ impl SavedSolver {
             equilibrium,
             accelerations,
             energy,
+            sleep,
         } = s;
         let mut records: Vec<_> = records
             .iter()
@@ -205,6 +212,8 @@ impl SavedSolver {
             equilibrium: *equilibrium,
             accelerations: *accelerations,
             energy: energy.clone(),
+            still: sleep.parts().0.to_vec(),
+            asleep: sleep.parts().1.to_vec(),
         }
     }
 
@@ -262,6 +271,8 @@ impl SavedSolver {
             equilibrium: self.equilibrium,
             accelerations: self.accelerations,
             energy: self.energy,
+            sleep: Sleep::from_parts(self.still, self.asleep)
+                .ok_or("the sleep state does not match the blocks")?,
         })
     }
 
@@ -273,6 +284,13 @@ impl SavedSolver {
             return Err(format!(
                 "{} initial boxes for {n} blocks",
                 self.initial_boxes.len()
+            ));
+        }
+        if self.still.len() != n || self.asleep.len() != n {
+            return Err(format!(
+                "sleep state of {} and {} blocks for {n} blocks",
+                self.still.len(),
+                self.asleep.len()
             ));
         }
         let block = |i: usize, what: &str| {
@@ -317,6 +335,8 @@ impl SavedParams {
             initial_equilibrium,
             equilibrium_tolerance,
             equilibrium_max_steps,
+            sleep_velocity,
+            sleep_time,
             contact,
             joint,
             joint_sets,
@@ -336,6 +356,8 @@ impl SavedParams {
             initial_equilibrium,
             equilibrium_tolerance,
             equilibrium_max_steps,
+            sleep_velocity,
+            sleep_time,
             contact,
             joint,
             joint_sets,
@@ -358,6 +380,8 @@ impl SavedParams {
             initial_equilibrium,
             equilibrium_tolerance,
             equilibrium_max_steps,
+            sleep_velocity,
+            sleep_time,
             contact,
             joint,
             joint_sets,
@@ -377,6 +401,8 @@ impl SavedParams {
             initial_equilibrium,
             equilibrium_tolerance,
             equilibrium_max_steps,
+            sleep_velocity,
+            sleep_time,
             contact,
             joint,
             joint_sets,

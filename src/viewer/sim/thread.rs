@@ -269,6 +269,13 @@ impl Sim {
             }
             Command::SetParams(p) => match p.validate() {
                 Ok(()) => {
+                    // A change of anything but the end time wakes every block: a sleeping
+                    // island was at rest under the old parameters, not necessarily the new.
+                    let mut ends_apart = (*p).clone();
+                    ends_apart.duration = self.solver.params.duration;
+                    if ends_apart != self.solver.params {
+                        self.solver.wake_all();
+                    }
                     self.solver.params = *p;
                     // The end time may have moved past or before the current time.
                     match (&self.state, self.solver.finished()) {

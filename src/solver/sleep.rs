@@ -1,0 +1,265 @@
+//! Sleeping islands: a group of blocks at rest is not stepped until something comes near it.
+//!
+//! An *island* is a set of movable blocks linked, directly or through others, by the broad
+//! phase's pairs (boxes within their search distance of each other); fixed blocks do not link
+//! islands, as a ground slab under two walls does not make them one. An island sleeps while
+//! every block in it has been *still* (its fastest vertex slower than `sleep_velocity`) for at
+//! least `sleep_time` of simulated time. A sleeping block is held exactly where it is: it takes
+//! no part in the narrow phase, the system or the commit, and the records of its contacts are
+//! carried unchanged, so that when it wakes its contacts start from the forces they had.
+//!
+//! Nothing at the edge of an island is approximated: a block that comes within search distance
+//! of a sleeping one joins its island in the broad phase, and the whole island is awake in the
+//! step in which a contact between them could first be detected. What sleeping changes is only
+//! this: a block slower than `sleep_velocity` for `sleep_time`, with all its island, stops. A
+//! block that accelerates from rest at a is stopped only if a · sleep_time < sleep_velocity
+//! (at the defaults, a < 10⁻⁴ m/s²: a block of factor of safety 1 − 2·10⁻⁵ on a 30° plane).
+//!
+//! A fixed block sleeps when every movable block near it sleeps, or, near none, when every
+//! movable block of the scene does. A fixed block near both a sleeping and an awake block (a
+//! ground slab under a settled column and a rolling rock) stays awake, and its contacts with the
+//! sleeping block are solved with that block held: it keeps carrying the block's weight instead
+//! of rising on its vertex springs and striking the block when it wakes. Rapier and Box2D put bodies to sleep by islands in the same way.
+
+/// Which blocks sleep, and how long each has been still.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub(crate) struct Sleep {
+    /// Simulated time each block has been still without interruption, s.
+    still: Vec<f64>,
+    /// Whether each block sleeps in the step under way.
+    asleep: Vec<bool>,
+}
+
+impl Sleep {
+    /// `n` blocks, all awake and none yet still.
+    pub fn new(n: usize) -> Self {
+        Sleep {
+            still: vec![0.0; n],
+            asleep: vec![false; n],
+        }
+    }
+
+    /// From saved state (a checkpoint); `None` if the lengths differ.
+    pub fn from_parts(still: Vec<f64>, asleep: Vec<bool>) -> Option<Self> {
+        (still.len() == asleep.len()).then_some(Sleep { still, asleep })
+    }
+
+    /// The time each block has been still, and whether it sleeps (for a checkpoint).
+    pub fn parts(&self) -> (&[f64], &[bool]) {
+        (&self.still, &self.asleep)
+    }
+
+    /// Whether block `i` sleeps in the step under way.
+    pub fn is_asleep(&self, i: usize) -> bool {
+        self.asleep.get(i).copied().unwrap_or(false)
+    }
+
+    /// Whether each block sleeps in the step under way.
+    pub fn asleep(&self) -> &[bool] {
+        &self.asleep
+    }
+
+    /// Whether any block sleeps.
+    pub fn any_asleep(&self) -> bool {
+        self.asleep.iter().any(|&a| a)
+    }
+
+    /// Whether every block sleeps (the step then has nothing to solve).
+    pub fn all_asleep(&self) -> bool {
+        self.asleep.iter().all(|&a| a)
+    }
+
+    /// Wakes every block and forgets how long it was still: after a change of the parameters,
+    /// the loads or the blocks from outside the solver.
+    pub fn wake_all(&mut self) {
+        self.still.fill(0.0);
+        self.asleep.fill(false);
+    }
+
+    /// Decides which blocks sleep in the coming step from the broad phase's `pairs` (a < b).
+    /// Returns the blocks that fall asleep now, whose motion the caller stops.
+    pub fn settle(
+        &mut self,
+        fixed: &[bool],
+        pairs: &[(usize, usize)],
+        sleep_time: f64,
+    ) -> Vec<usize> {
+        let asleep = sleeping_blocks(fixed, pairs, &self.still, sleep_time);
+        let fallen = (0..asleep.len())
+            .filter(|&i| asleep[i] && !self.asleep[i] && !fixed[i])
+            .collect();
+        self.asleep = asleep;
+        fallen
+    }
+
+    /// After a step of `dt`: each awake movable block whose fastest vertex (`speeds`, m/s) is
+    /// slower than `sleep_velocity` has been still `dt` longer; any other starts again from 0.
+    /// A sleeping block keeps its time. `sleep_velocity` 0 keeps every block awake.
+    pub fn record(&mut self, fixed: &[bool], speeds: &[f64], dt: f64, sleep_velocity: f64) {
+        for (i, s) in self.still.iter_mut().enumerate() {
+            if self.asleep[i] || fixed[i] {
+                continue;
+            }
+            *s = if speeds[i] < sleep_velocity {
+                *s + dt
+            } else {
+                0.0
+            };
+        }
+    }
+}
+
+/// Which blocks sleep: the movable blocks of every island whose blocks have all been still for
+/// `sleep_time`; the fixed blocks near at least one movable block and near no awake one; and
+/// the other fixed blocks once every movable block sleeps.
+pub(crate) fn sleeping_blocks(
+    fixed: &[bool],
+    pairs: &[(usize, usize)],
+    still: &[f64],
+    sleep_time: f64,
+) -> Vec<bool> {
+    let n = fixed.len();
+    let islands = islands(fixed, pairs);
+    // An island is ready when its least still block is.
+    let mut ready = vec![true; n];
+    for i in (0..n).filter(|&i| !fixed[i]) {
+        ready[islands[i]] &= still[i] >= sleep_time;
+    }
+    let mut asleep: Vec<bool> = (0..n).map(|i| !fixed[i] && ready[islands[i]]).collect();
+    // A fixed block: asleep if it has a movable neighbour and all of them sleep.
+    let mut near_movable = vec![false; n];
+    let mut near_awake = vec![false; n];
+    for &(a, b) in pairs {
+        for (f, m) in [(a, b), (b, a)] {
+            if fixed[f] && !fixed[m] {
+                near_movable[f] = true;
+                near_awake[f] |= !asleep[m];
+            }
+        }
+    }
+    // A fixed block near no movable one (a ground slab under a fixed bottom layer) sleeps when
+    // every movable block does: nothing it does can then reach a movable block.
+    let all_movable_asleep = (0..n).any(|i| !fixed[i]) && (0..n).all(|i| fixed[i] || asleep[i]);
+    for i in (0..n).filter(|&i| fixed[i]) {
+        asleep[i] = if near_movable[i] {
+            !near_awake[i]
+        } else {
+            all_movable_asleep
+        };
+    }
+    asleep
+}
+
+/// Each block's island, named by its smallest member: movable blocks linked by `pairs`
+/// (a fixed block is an island of its own and links nothing).
+pub(crate) fn islands(fixed: &[bool], pairs: &[(usize, usize)]) -> Vec<usize> {
+    let mut parent: Vec<usize> = (0..fixed.len()).collect();
+    fn root(parent: &mut [usize], mut k: usize) -> usize {
+        while parent[k] != k {
+            parent[k] = parent[parent[k]];
+            k = parent[k];
+        }
+        k
+    }
+    for &(a, b) in pairs {
+        if fixed[a] || fixed[b] {
+            continue;
+        }
+        let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+        if ra != rb {
+            // The smaller index names the island, whatever the order of the pairs.
+            parent[ra.max(rb)] = ra.min(rb);
+        }
+    }
+    (0..fixed.len()).map(|k| root(&mut parent, k)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Blocks 0–2 a chain on the fixed slab 3; block 4 apart on the slab; block 5 alone.
+    fn scene() -> (Vec<bool>, Vec<(usize, usize)>) {
+        let fixed = vec![false, false, false, true, false, false];
+        let pairs = vec![(0, 1), (0, 3), (1, 2), (3, 4)];
+        (fixed, pairs)
+    }
+
+    #[test]
+    fn islands_are_linked_through_movable_blocks_only() {
+        let (fixed, pairs) = scene();
+        assert_eq!(islands(&fixed, &pairs), vec![0, 0, 0, 3, 4, 5]);
+        // The order of the pairs does not matter.
+        let mut reversed = pairs.clone();
+        reversed.reverse();
+        assert_eq!(islands(&fixed, &reversed), islands(&fixed, &pairs));
+    }
+
+    #[test]
+    fn an_island_sleeps_only_when_all_its_blocks_have_been_still_long_enough() {
+        let (fixed, pairs) = scene();
+        let t = 0.1;
+        // Block 2 not yet still long enough: its whole island stays awake, and so does the slab
+        // under it; block 4 sleeps alone; block 5 too.
+        let still = [0.2, 0.3, 0.05, 0.0, 0.1, 0.5];
+        let asleep = sleeping_blocks(&fixed, &pairs, &still, t);
+        assert_eq!(asleep, vec![false, false, false, false, true, true]);
+        // All still: everything sleeps, the slab with them.
+        let still = [0.2, 0.3, 0.1, 0.0, 0.1, 0.5];
+        let asleep = sleeping_blocks(&fixed, &pairs, &still, t);
+        assert_eq!(asleep, vec![true; 6]);
+    }
+
+    #[test]
+    fn a_lone_fixed_block_sleeps_only_when_every_movable_block_does() {
+        let asleep = sleeping_blocks(&[true, false], &[], &[0.0, 1.0], 0.1);
+        assert_eq!(asleep, vec![true, true]);
+        let asleep = sleeping_blocks(&[true, false], &[], &[0.0, 0.0], 0.1);
+        assert_eq!(asleep, vec![false, false]);
+        // A scene of fixed blocks alone never sleeps.
+        let asleep = sleeping_blocks(&[true, true], &[], &[0.0, 0.0], 0.1);
+        assert_eq!(asleep, vec![false, false]);
+    }
+
+    #[test]
+    fn a_block_coming_near_wakes_the_island() {
+        let (fixed, mut pairs) = scene();
+        let mut sleep = Sleep::new(fixed.len());
+        sleep.still = vec![1.0; 6];
+        sleep.still[5] = 0.0; // block 5 moves
+        let fallen = sleep.settle(&fixed, &pairs, 0.1);
+        assert_eq!(fallen, vec![0, 1, 2, 4]);
+        assert!(sleep.is_asleep(3) && !sleep.is_asleep(5));
+        // Block 5 comes within search distance of block 2: the chain and its slab wake; block 4
+        // sleeps on.
+        pairs.push((2, 5));
+        pairs.sort_unstable();
+        assert!(sleep.settle(&fixed, &pairs, 0.1).is_empty());
+        assert_eq!(
+            sleep.asleep(),
+            &[false, false, false, false, true, false][..]
+        );
+        // The woken blocks kept their still time: once block 5 has been still long enough,
+        // they sleep again together.
+        sleep.record(&fixed, &[0.0; 6], 0.1, 1e-5);
+        assert_eq!(sleep.settle(&fixed, &pairs, 0.1), vec![0, 1, 2, 5]);
+    }
+
+    #[test]
+    fn recording_counts_still_time_and_restarts_it_on_motion() {
+        let fixed = [false, false, true];
+        let mut sleep = Sleep::new(3);
+        let speeds = [1e-6, 1e-3, 1.0];
+        sleep.record(&fixed, &speeds, 0.01, 1e-5);
+        sleep.record(&fixed, &speeds, 0.01, 1e-5);
+        assert_eq!(sleep.still, vec![0.02, 0.0, 0.0]);
+        sleep.record(&fixed, &[1e-4, 0.0, 0.0], 0.01, 1e-5);
+        assert_eq!(sleep.still, vec![0.0, 0.01, 0.0]);
+        // Sleeping switched off: nothing is ever still.
+        sleep.record(&fixed, &[0.0; 3], 0.01, 0.0);
+        assert_eq!(sleep.still, vec![0.0; 3]);
+        sleep.still = vec![1.0; 3];
+        sleep.wake_all();
+        assert_eq!(sleep.still, vec![0.0; 3]);
+    }
+}
