@@ -97,6 +97,10 @@ pub struct SolverOverrides {
     /// `initial_equilibrium = true`).
     #[arg(long)]
     pub initial_equilibrium: bool,
+    /// A block is still below this speed, m/s, and an island of still blocks sleeps (the
+    /// scene's `sleep_velocity`; 0: no block sleeps).
+    #[arg(long, allow_negative_numbers = true)]
+    pub sleep_velocity: Option<f64>,
 }
 
 /// How a command failed, and with which exit status.
@@ -166,6 +170,12 @@ pub fn load_scene(path: &Path, o: &SolverOverrides) -> Result<Scene, CliError> {
             &table::MAX_TIME_STEP,
             o.max_time_step,
             &mut p.max_time_step,
+        ),
+        (
+            "--sleep-velocity",
+            &table::SLEEP_VELOCITY,
+            o.sleep_velocity,
+            &mut p.sleep_velocity,
         ),
     ] {
         if let Some(v) = value {

@@ -49,7 +49,7 @@ pub struct RunArgs {
     #[arg(
         long,
         value_name = "CHECKPOINT",
-        conflicts_with_all = ["scene", "method", "mode", "spectral_radius", "max_time_step", "initial_equilibrium"]
+        conflicts_with_all = ["scene", "method", "mode", "spectral_radius", "max_time_step", "initial_equilibrium", "sleep_velocity"]
     )]
     pub resume: Option<PathBuf>,
     #[command(flatten)]

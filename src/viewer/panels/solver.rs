@@ -165,7 +165,7 @@ fn strength_rows(ui: &mut egui::Ui, j: &mut JointParams, young: f64, set: Option
     ui.end_row();
 }
 
-/// Time stepping: δ, Δt_max and the end time.
+/// Time stepping: δ, Δt_max, ρ∞, sleeping and the end time.
 fn time_rows(ui: &mut egui::Ui, e: &mut SolverParams, model: &Model) {
     let young = model.young;
     param_label(ui, &table::MAX_DISPLACEMENT_RATIO);
@@ -207,6 +207,29 @@ fn time_rows(ui: &mut egui::Ui, e: &mut SolverParams, model: &Model) {
         )
     };
     ui.label(RichText::new(scheme).weak());
+    ui.end_row();
+
+    // Sleeping islands (dynamic runs only): 0 switches sleeping off.
+    ui.add_enabled_ui(dynamic, |ui| param_label(ui, &table::SLEEP_VELOCITY));
+    ui.add_enabled(
+        dynamic,
+        param_slider(&mut e.sleep_velocity, &table::SLEEP_VELOCITY, young).smallest_positive(1e-7),
+    );
+    ui.label(
+        RichText::new(if e.sleep_velocity > 0.0 {
+            ""
+        } else {
+            "never sleeps"
+        })
+        .weak(),
+    );
+    ui.end_row();
+    ui.add_enabled_ui(dynamic, |ui| param_label(ui, &table::SLEEP_TIME));
+    ui.add_enabled(
+        dynamic && e.sleep_velocity > 0.0,
+        param_slider(&mut e.sleep_time, &table::SLEEP_TIME, young),
+    );
+    ui.label(RichText::new(seconds(e.sleep_time)).weak());
     ui.end_row();
 
     param_label(ui, &table::DURATION);
