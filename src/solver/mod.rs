@@ -1,7 +1,9 @@
 //! The DDA-3a / DDA-3p time stepper. A step runs through its stages in order, each a function
 //! that takes what it reads and returns or changes what it owns:
 //!
-//! 1. [`activate`]: detect the contacts and attach their records (reference §4);
+//! 1. [`activate`]: the broad phase; then [`sleep`] decides which islands of blocks at rest
+//!    sleep (held exactly, their contacts carried unchanged), and the narrow phase detects the
+//!    contacts of the awake blocks and attaches their records (reference §4);
 //! 2. [`assemble`]: the step's sparsity pattern, the block terms (K0, F0) and the contact terms;
 //! 3. [`attempt`]: the open–close iteration ([`open_close`]) around the ALM loop ([`alm`]),
 //!    paper Fig. 3, then the step-size checks;
@@ -391,87 +393,6 @@ impl Solver {
         self.last = commit::with_energy(stats, &self.model.blocks, self.params.gravity);
         self.dt = step_control::next_dt(&self.params, base, dt, cuts);
         Ok((dt, solved.settled))
-    }
-
-    /// Whether blocks may sleep now: in a dynamic run with a sleep velocity, after the
-    /// equilibrium stage (which brings the model to rest by its own measure).
-    fn sleeping(&self) -> bool {
-        self.stage.is_none()
-            && self.params.mode == Mode::Dynamic
-            && self.params.sleep_velocity > 0.0
-    }
-
-    /// Decides which blocks sleep in the coming step ([`sleep`]), and stops those that fall
-    /// asleep now (each slower than the sleep velocity).
-    fn settle_sleep(&mut self, groups: &ContactGroups) {
-        if !self.sleeping() {
-            if self.sleep.any_asleep() {
-                self.sleep.wake_all();
-            }
-            return;
-        }
-        let fixed: Vec<bool> = self.model.blocks.iter().map(|b| b.fixed).collect();
-        for i in self
-            .sleep
-            .settle(&fixed, &groups.pairs, self.params.sleep_time)
-        {
-            self.model.blocks[i].set_kinematics(Kinematics::at_rest());
-        }
-    }
-
-    /// Wakes every block: after the parameters, loads or blocks were changed from outside the
-    /// solver (the viewer's panel).
-    pub fn wake_all(&mut self) {
-        self.sleep.wake_all();
-    }
-
-    /// Whether block `i` sleeps.
-    pub fn is_asleep(&self, i: usize) -> bool {
-        self.sleep.is_asleep(i)
-    }
-
-    /// The records and closed contacts of pairs of sleeping blocks, carried unchanged from the
-    /// last step into this one's (no contact of theirs was searched), and counted in `stats`.
-    fn carry_sleeping(
-        &self,
-        held: &[bool],
-        records: &mut RecordMap,
-        contacts: &mut Vec<ContactSnapshot>,
-        stats: &mut StepStats,
-    ) {
-        for (k, r) in &self.records {
-            if held[k.i as usize] && held[k.j as usize] {
-                records.insert(*k, *r);
-            }
-        }
-        for c in &self.contacts {
-            if held[c.block_i] && held[c.block_j] {
-                contacts.push(c.clone());
-                match c.state {
-                    crate::contact::ContactState::Lock => stats.contacts_lock += 1,
-                    crate::contact::ContactState::Slide => stats.contacts_slide += 1,
-                    crate::contact::ContactState::Open => {}
-                }
-            }
-        }
-        stats.blocks_asleep = held.iter().filter(|&&h| h).count() as u32;
-    }
-
-    /// A step in which every block sleeps: nothing moves, the contacts keep their records and
-    /// forces. Returns the step taken.
-    fn rest(&mut self, dt: f64, base: f64) -> f64 {
-        let count = |s| self.contacts.iter().filter(|c| c.state == s).count() as u32;
-        let stats = StepStats {
-            time_step: dt,
-            contacts_lock: count(crate::contact::ContactState::Lock),
-            contacts_slide: count(crate::contact::ContactState::Slide),
-            blocks_asleep: self.model.blocks.len() as u32,
-            ..Default::default()
-        };
-        self.count(&stats, 0);
-        self.last = commit::with_energy(stats, &self.model.blocks, self.params.gravity);
-        self.dt = step_control::next_dt(&self.params, base, dt, 0);
-        dt
     }
 
     /// Stage 1: this step's contacts (none between two `held` blocks), and the global matrix

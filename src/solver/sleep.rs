@@ -19,7 +19,17 @@
 //! movable block of the scene does. A fixed block near both a sleeping and an awake block (a
 //! ground slab under a settled column and a rolling rock) stays awake, and its contacts with the
 //! sleeping block are solved with that block held: it keeps carrying the block's weight instead
-//! of rising on its vertex springs and striking the block when it wakes. Rapier and Box2D put bodies to sleep by islands in the same way.
+//! of rising on its vertex springs and striking the block when it wakes.
+//!
+//! Rapier and Box2D put bodies to sleep by islands in the same way.
+
+use super::{Solver, commit, step_control};
+use crate::contact::ContactState;
+use crate::contact::groups::ContactGroups;
+use crate::contact::record::RecordMap;
+use crate::params::Mode;
+use crate::physics::integrator::Kinematics;
+use crate::snapshot::{ContactSnapshot, StepStats};
 
 /// Which blocks sleep, and how long each has been still.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -106,6 +116,90 @@ impl Sleep {
                 0.0
             };
         }
+    }
+}
+
+/// The solver's side of sleeping: deciding, holding, carrying and counting.
+impl Solver {
+    /// Whether blocks may sleep now: in a dynamic run with a sleep velocity, after the
+    /// equilibrium stage (which brings the model to rest by its own measure).
+    pub(super) fn sleeping(&self) -> bool {
+        self.stage.is_none()
+            && self.params.mode == Mode::Dynamic
+            && self.params.sleep_velocity > 0.0
+    }
+
+    /// Decides which blocks sleep in the coming step ([`sleep`]), and stops those that fall
+    /// asleep now (each slower than the sleep velocity).
+    pub(super) fn settle_sleep(&mut self, groups: &ContactGroups) {
+        if !self.sleeping() {
+            if self.sleep.any_asleep() {
+                self.sleep.wake_all();
+            }
+            return;
+        }
+        let fixed: Vec<bool> = self.model.blocks.iter().map(|b| b.fixed).collect();
+        for i in self
+            .sleep
+            .settle(&fixed, &groups.pairs, self.params.sleep_time)
+        {
+            self.model.blocks[i].set_kinematics(Kinematics::at_rest());
+        }
+    }
+
+    /// Wakes every block: after the parameters, loads or blocks were changed from outside the
+    /// solver (the viewer's panel).
+    pub fn wake_all(&mut self) {
+        self.sleep.wake_all();
+    }
+
+    /// Whether block `i` sleeps.
+    pub fn is_asleep(&self, i: usize) -> bool {
+        self.sleep.is_asleep(i)
+    }
+
+    /// The records and closed contacts of pairs of sleeping blocks, carried unchanged from the
+    /// last step into this one's (no contact of theirs was searched), and counted in `stats`.
+    pub(super) fn carry_sleeping(
+        &self,
+        held: &[bool],
+        records: &mut RecordMap,
+        contacts: &mut Vec<ContactSnapshot>,
+        stats: &mut StepStats,
+    ) {
+        for (k, r) in &self.records {
+            if held[k.i as usize] && held[k.j as usize] {
+                records.insert(*k, *r);
+            }
+        }
+        for c in &self.contacts {
+            if held[c.block_i] && held[c.block_j] {
+                contacts.push(c.clone());
+                match c.state {
+                    ContactState::Lock => stats.contacts_lock += 1,
+                    ContactState::Slide => stats.contacts_slide += 1,
+                    ContactState::Open => {}
+                }
+            }
+        }
+        stats.blocks_asleep = held.iter().filter(|&&h| h).count() as u32;
+    }
+
+    /// A step in which every block sleeps: nothing moves, the contacts keep their records and
+    /// forces. Returns the step taken.
+    pub(super) fn rest(&mut self, dt: f64, base: f64) -> f64 {
+        let count = |s| self.contacts.iter().filter(|c| c.state == s).count() as u32;
+        let stats = StepStats {
+            time_step: dt,
+            contacts_lock: count(ContactState::Lock),
+            contacts_slide: count(ContactState::Slide),
+            blocks_asleep: self.model.blocks.len() as u32,
+            ..Default::default()
+        };
+        self.count(&stats, 0);
+        self.last = commit::with_energy(stats, &self.model.blocks, self.params.gravity);
+        self.dt = step_control::next_dt(&self.params, base, dt, 0);
+        dt
     }
 }
 
