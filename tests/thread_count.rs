@@ -29,8 +29,9 @@ fn dda3d(threads: usize) -> Command {
     c
 }
 
-/// Runs `scene` with 1, 2 and 3 threads and checks that the CSV files are identical.
-fn same_for_any_thread_count(tag: &str, scene: &Path, extra: &[&str]) {
+/// Runs `scene` with 1, 2 and 3 threads and checks that the CSV files are identical. Returns
+/// the one-thread run's `summary.json`.
+fn same_for_any_thread_count(tag: &str, scene: &Path, extra: &[&str]) -> String {
     let dir = tmp(tag);
     let mut outputs: Vec<(Vec<u8>, Vec<u8>)> = Vec::new();
     for threads in 1..=3 {
@@ -64,7 +65,9 @@ fn same_for_any_thread_count(tag: &str, scene: &Path, extra: &[&str]) {
             k + 1
         );
     }
+    let summary = std::fs::read_to_string(dir.join("t1/summary.json")).unwrap();
     let _ = std::fs::remove_dir_all(&dir);
+    summary
 }
 
 #[test]
@@ -89,6 +92,25 @@ fn struck_wall_is_identical_with_any_thread_count() {
         .unwrap();
     assert!(status.success());
     same_for_any_thread_count("wall", &wall, &["--duration", "0.4"]);
+}
+
+#[test]
+fn a_sleeping_wall_woken_by_a_rock_is_identical_with_any_thread_count() {
+    // A standing wall of 20 falls asleep about 0.2 s in; a cube dropped from 6 m above it
+    // wakes it at about 1.1 s (`tests/sleeping.rs`).
+    let dir = tmp("sleeping");
+    let wall = dir.join("wall.toml");
+    let mut text = dda3d::generate::column_wall(20, 5, false);
+    text += "\n[[blocks]]\nname = \"rock\"\nmaterial = \"rock\"\n\
+             box = { size = [0.8, 0.8, 0.8], center = [0.1, 0.3, 16.4] }\n";
+    std::fs::write(&wall, text).unwrap();
+    let summary = same_for_any_thread_count("sleeping", &wall, &["--duration", "1.6"]);
+    let summary: serde_json::Value = serde_json::from_str(&summary).unwrap();
+    let asleep = summary["sleeping_steps"].as_u64().unwrap_or(0);
+    assert!(
+        (50..150).contains(&asleep),
+        "the wall sleeps until the rock comes: {asleep} of 160 steps"
+    );
 }
 
 #[test]

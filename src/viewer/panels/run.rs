@@ -24,6 +24,15 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
             row("Time-step cuts", t.time_step_cuts.to_string());
             row("Unconverged steps", t.unconverged_steps.to_string());
             row("ALM cap hits", t.alm_cap_hits.to_string());
+            // Islands at rest, held still (`solver.sleep_velocity`).
+            row(
+                "Blocks asleep",
+                format!(
+                    "{} of {}",
+                    f.snapshot.stats.blocks_asleep,
+                    f.snapshot.blocks.len()
+                ),
+            );
             row("Max penetration", length(t.max_penetration));
             row("d_n,max = 2δw0", length(f.max_step_penetration));
             row("Solver time / step", seconds(f.seconds_per_step));
