@@ -240,3 +240,61 @@ fn a_block_that_slides_never_sleeps() {
         }
     }
 }
+
+/// Two columns of three blocks 4 m apart on one fixed slab, and a cube dropped from 6 m onto
+/// the second.
+fn two_columns_one_struck() -> String {
+    let mut text = dropped_rock(3, 0.8, 6.0, 0.0).replace("[8, 8, 1]", "[14, 8, 1]");
+    for k in 0..3 {
+        text += &format!(
+            "[[blocks]]\nname = \"d{k}\"\nmaterial = \"rock\"\n\
+             box = {{ size = [1.2, 1.2, 2], center = [4, 0, {}] }}\n",
+            2.0 * k as f64 + 1.0
+        );
+    }
+    // The rock falls on the second column instead of the first.
+    text.replace("center = [0, 0, 12.4]", "center = [4, 0, 12.4]")
+}
+
+#[test]
+fn a_column_sleeps_on_a_slab_shared_with_a_struck_one() {
+    let text = two_columns_one_struck();
+    assert!(
+        text.contains("center = [4, 0, 12.4]"),
+        "the rock is above the second column"
+    );
+    let s = scene::parse(&text, "two.toml", "two").expect("scene parses");
+    let mut on = solver(&s, |_| {});
+    let mut off = solver(&s, |p| p.sleep_velocity = 0.0);
+    let (first, second) = (1..=3, 5..=7);
+    let (mut shared, mut woken) = (false, false);
+    while !on.finished() {
+        on.step().expect("runs");
+        let first_asleep = first.clone().all(|i| on.is_asleep(i));
+        let second_awake = second.clone().all(|i| !on.is_asleep(i));
+        if first_asleep && second_awake {
+            // The slab is awake under the struck column, and its contacts with the sleeping
+            // one are solved with that column held.
+            assert!(!on.is_asleep(0), "the slab is awake");
+            shared = true;
+        }
+        woken |= shared && !first_asleep;
+    }
+    assert!(shared, "the first column sleeps while the second is awake");
+    // The impact shakes the slab on its vertex springs, which changes the forces under the
+    // first column and wakes it, so that it follows the slab as it does without sleeping.
+    assert!(woken, "the shaken slab wakes the first column");
+    while !off.finished() {
+        off.step().expect("runs");
+    }
+    let (a, b) = (centroids(&on), centroids(&off));
+    let slab = largest_gap(&a[..1], &b[..1]);
+    let column = largest_gap(&a[1..4], &b[1..4]);
+    println!("slab {slab:.2e} m, first column {column:.2e} m from the run without sleeping");
+    // Measured: slab 4.7·10⁻¹⁰ m, column 2.3·10⁻⁸ m; without the waking, which let the held
+    // column lose its support on the shaken slab, 1.5·10⁻⁸ and 3.4·10⁻⁷ m.
+    assert!(
+        slab < 5e-9 && column < 1e-7,
+        "slab {slab:.3e} m, column {column:.3e} m"
+    );
+}

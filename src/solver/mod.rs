@@ -386,6 +386,9 @@ impl Solver {
             let speeds: Vec<f64> = self.model.blocks.iter().map(|b| b.peak_speed()).collect();
             self.sleep
                 .record(&fixed, &speeds, dt, self.params.sleep_velocity);
+            if !held.is_empty() {
+                self.wake_disturbed(&held, &active);
+            }
         }
         self.totals.timings.bookkeeping += watch.seconds();
 

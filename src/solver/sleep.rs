@@ -23,6 +23,7 @@
 //!
 //! Rapier and Box2D put bodies to sleep by islands in the same way.
 
+use super::active::Active;
 use super::{Solver, commit, step_control};
 use crate::contact::ContactState;
 use crate::contact::groups::ContactGroups;
@@ -77,6 +78,11 @@ impl Sleep {
     /// Whether every block sleeps (the step then has nothing to solve).
     pub fn all_asleep(&self) -> bool {
         self.asleep.iter().all(|&a| a)
+    }
+
+    /// Block `i` was disturbed: it, and so its island, is no longer still.
+    pub fn disturb(&mut self, i: usize) {
+        self.still[i] = 0.0;
     }
 
     /// Wakes every block and forgets how long it was still: after a change of the parameters,
@@ -183,6 +189,27 @@ impl Solver {
             }
         }
         stats.blocks_asleep = held.iter().filter(|&&h| h).count() as u32;
+    }
+
+    /// Wakes, for the next step, the island of every sleeping block whose contact with an awake
+    /// block (a fixed one: no other touches a sleeping island) changed state or changed its
+    /// normal force by more than ε2 of itself in this step: the fixed block moved under it (a
+    /// slab shaken by an impact elsewhere), and the held block should follow.
+    pub(super) fn wake_disturbed(&mut self, held: &[bool], active: &[Active]) {
+        let eps = self.params.contact.eps2;
+        for c in active {
+            let (i, j) = c.blocks();
+            if held[i] == held[j] {
+                continue;
+            }
+            let force = |closed: bool, n: f64| if closed { n } else { 0.0 };
+            let before = force(c.start.state.is_closed(), c.start.normal_force);
+            let after = force(c.rec.state.is_closed(), c.force);
+            let scale = before.abs().max(after.abs());
+            if c.start.state != c.rec.state || (after - before).abs() > eps * scale {
+                self.sleep.disturb(if held[i] { i } else { j });
+            }
+        }
     }
 
     /// A step in which every block sleeps: nothing moves, the contacts keep their records and
