@@ -198,7 +198,12 @@ impl Solver {
 
     /// Advances one step without passing `limit` (so that outputs land on requested times).
     /// While the initial equilibrium stage runs, a step is one of its static steps instead.
+    /// At or past `limit` (or the duration) there is no room for a step, and none is taken:
+    /// a step of zero length changed nothing but the step count, forever in a caller's loop.
     pub fn step_until(&mut self, limit: f64) -> Result<&StepStats, SolverError> {
+        if self.stage.is_none() && limit.min(self.params.duration) <= self.time {
+            return Ok(&self.last);
+        }
         // The step runs on a thread of rayon's pool: its parallel loops then split work on that
         // thread's own queue instead of handing each one over from outside the pool and waiting
         // (tens of microseconds a loop, and a struck wall has hundreds of loops a step).
