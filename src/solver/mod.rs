@@ -332,6 +332,13 @@ impl Solver {
     /// and whether its open–close iteration was settled rather than converged.
     fn advance(&mut self, room: f64) -> Result<(f64, bool), SolverError> {
         let watch = Stopwatch::start();
+        if let Some(predicted) = self.sleep.resting().filter(|_| self.sleeping()) {
+            // Every block sleeps, as in the last step: nothing to detect, predict or solve.
+            let base = self.dt.min(predicted);
+            let first = step_control::first_attempt(base, room);
+            self.totals.timings.detection += watch.seconds();
+            return Ok((self.rest(first, base, predicted), false));
+        }
         if self.params.mode == Mode::Static {
             for b in &mut self.model.blocks {
                 b.set_kinematics(Kinematics::at_rest());
@@ -345,7 +352,7 @@ impl Solver {
         let first = step_control::first_attempt(base, room);
         if self.sleep.all_asleep() && !self.model.blocks.is_empty() {
             self.totals.timings.detection += watch.seconds();
-            return Ok((self.rest(first, base), false));
+            return Ok((self.rest(first, base, predicted), false));
         }
         // The sleeping blocks, held where they are (none: empty).
         let held = if self.sleep.any_asleep() {

@@ -39,6 +39,10 @@ pub(crate) struct Sleep {
     still: Vec<f64>,
     /// Whether each block sleeps in the step under way.
     asleep: Vec<bool>,
+    /// While every block sleeps: the Δt the step control predicted when they all fell asleep.
+    /// Nothing moves until something wakes them ([`Sleep::wake_all`]), so the broad phase and
+    /// the prediction would give the same again.
+    resting: Option<f64>,
 }
 
 impl Sleep {
@@ -47,17 +51,28 @@ impl Sleep {
         Sleep {
             still: vec![0.0; n],
             asleep: vec![false; n],
+            resting: None,
         }
     }
 
     /// From saved state (a checkpoint); `None` if the lengths differ.
-    pub fn from_parts(still: Vec<f64>, asleep: Vec<bool>) -> Option<Self> {
-        (still.len() == asleep.len()).then_some(Sleep { still, asleep })
+    pub fn from_parts(still: Vec<f64>, asleep: Vec<bool>, resting: Option<f64>) -> Option<Self> {
+        (still.len() == asleep.len()).then_some(Sleep {
+            still,
+            asleep,
+            resting,
+        })
     }
 
-    /// The time each block has been still, and whether it sleeps (for a checkpoint).
-    pub fn parts(&self) -> (&[f64], &[bool]) {
-        (&self.still, &self.asleep)
+    /// The time each block has been still, whether it sleeps, and the resting Δt (for a
+    /// checkpoint).
+    pub fn parts(&self) -> (&[f64], &[bool], Option<f64>) {
+        (&self.still, &self.asleep, self.resting)
+    }
+
+    /// The Δt predicted when every block fell asleep, while they all still sleep.
+    pub fn resting(&self) -> Option<f64> {
+        self.resting
     }
 
     /// Whether block `i` sleeps in the step under way.
@@ -90,6 +105,7 @@ impl Sleep {
     pub fn wake_all(&mut self) {
         self.still.fill(0.0);
         self.asleep.fill(false);
+        self.resting = None;
     }
 
     /// Decides which blocks sleep in the coming step from the broad phase's `pairs` (a < b).
@@ -214,7 +230,8 @@ impl Solver {
 
     /// A step in which every block sleeps: nothing moves, the contacts keep their records and
     /// forces. Returns the step taken.
-    pub(super) fn rest(&mut self, dt: f64, base: f64) -> f64 {
+    pub(super) fn rest(&mut self, dt: f64, base: f64, predicted: f64) -> f64 {
+        self.sleep.resting = Some(predicted);
         let count = |s| self.contacts.iter().filter(|c| c.state == s).count() as u32;
         let stats = StepStats {
             time_step: dt,

@@ -259,6 +259,20 @@ box = { size = [0.8, 0.8, 0.8], center = [0, 0, 9] }
         }
         assert!(woken, "the rock wakes the column");
         assert_eq!(fingerprint(&a), fingerprint(&b));
+        // Without the rock everything sleeps, and a restored solver goes on resting with the
+        // same steps.
+        let column = &text[..text.find("name = \"rock\"").unwrap() - "[[blocks]]\n".len()];
+        let s = scene::parse(column, "column.toml", "column").unwrap();
+        let mut a = Solver::new(s.model, s.params);
+        while a.sleep.resting().is_none() {
+            a.step().unwrap();
+            assert!(a.time < 1.0, "everything sleeps by 1 s");
+        }
+        let mut b = decode(&encode(&a)).unwrap();
+        assert_eq!(fingerprint(&a), fingerprint(&b));
+        steps(&mut a, 5);
+        steps(&mut b, 5);
+        assert_eq!(fingerprint(&a), fingerprint(&b));
     }
 
     /// A restored solver's records live in a new `HashMap`, iterated in another order: the bytes

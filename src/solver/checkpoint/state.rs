@@ -60,9 +60,10 @@ pub(super) struct SavedSolver {
     equilibrium: Option<EquilibriumReport>,
     accelerations: bool,
     energy: Option<EnergyWatch>,
-    /// Each block's still time, s, and whether it sleeps.
+    /// Each block's still time, s, whether it sleeps, and the Δt of a model asleep throughout.
     still: Vec<f64>,
     asleep: Vec<bool>,
+    resting: Option<f64>,
 }
 
 /// [`SolverParams`] with every field, the ones a scene file does not hold too (its own serde
@@ -214,6 +215,7 @@ impl SavedSolver {
             energy: energy.clone(),
             still: sleep.parts().0.to_vec(),
             asleep: sleep.parts().1.to_vec(),
+            resting: sleep.parts().2,
         }
     }
 
@@ -271,7 +273,7 @@ impl SavedSolver {
             equilibrium: self.equilibrium,
             accelerations: self.accelerations,
             energy: self.energy,
-            sleep: Sleep::from_parts(self.still, self.asleep)
+            sleep: Sleep::from_parts(self.still, self.asleep, self.resting)
                 .ok_or("the sleep state does not match the blocks")?,
         })
     }
