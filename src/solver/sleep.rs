@@ -19,7 +19,12 @@
 //! movable block of the scene does. A fixed block near both a sleeping and an awake block (a
 //! ground slab under a settled column and a rolling rock) stays awake, and its contacts with the
 //! sleeping block are solved with that block held: it keeps carrying the block's weight instead
-//! of rising on its vertex springs and striking the block when it wakes.
+//! of rising on its vertex springs and striking the block when it wakes. Where one of those
+//! contacts changes state, or its force by more than ε2, in a step (the slab shaken by an impact
+//! elsewhere), the sleeping island wakes for the next step and follows.
+//!
+//! While every block sleeps, a step only counts: nothing has moved since they fell asleep, so
+//! the broad phase and the Δt prediction would give what they gave then.
 //!
 //! Rapier and Box2D put bodies to sleep by islands in the same way.
 
