@@ -26,6 +26,8 @@ fn load(name: &str, rho: f64) -> Scene {
 fn alternation(rho: f64) -> f64 {
     let mut s = load("slope_stable.toml", rho);
     s.params.mode = dda3d::params::Mode::Dynamic;
+    // The integrator's damping, not sleeping's: asleep, the block's forces would be held.
+    s.params.sleep_velocity = 0.0;
     let mut solver = Solver::new(s.model, s.params);
     let mut upslope = Vec::new();
     while !solver.finished() {
