@@ -57,27 +57,21 @@ pub(crate) fn activate(
     initial_boxes: &[(Vec3, Vec3)],
 ) -> (Vec<Active>, ContactGroups) {
     let groups = contact_groups(inp.params, inp.blocks, initial_boxes);
-    let active = activate_awake(inp, &groups, &[]);
+    let active = activate_awake(inp, &groups, &groups.pairs);
     (active, groups)
 }
 
-/// This step's contacts between the pairs of `groups` of which at least one block is awake
-/// (`asleep[i]` false, or `asleep` empty): two sleeping blocks are not searched.
+/// This step's contacts between the block pairs `pairs` of `groups` (all its pairs, or those
+/// with an awake block: two sleeping blocks are not searched).
 pub(crate) fn activate_awake(
     inp: &ActivationInputs,
     groups: &ContactGroups,
-    asleep: &[bool],
+    pairs: &[(usize, usize)],
 ) -> Vec<Active> {
     let p = inp.params;
-    let sleeps = |i: usize| asleep.get(i).copied().unwrap_or(false);
-    let pairs: Vec<(usize, usize)> = groups
-        .pairs
-        .iter()
-        .copied()
-        .filter(|&(a, b)| !(sleeps(a) && sleeps(b)))
-        .collect();
-    let mut needed = vec![asleep.is_empty(); inp.blocks.len()];
-    for &(a, b) in &pairs {
+    // The shapes of the blocks some pair searches.
+    let mut needed = vec![false; inp.blocks.len()];
+    for &(a, b) in pairs {
         needed[a] = true;
         needed[b] = true;
     }

@@ -5,6 +5,7 @@
 use rayon::prelude::*;
 
 use super::active::{Active, StiffnessKey};
+use super::sleep::is_held;
 use super::{PAR_BLOCKS, PAR_CONTACTS};
 use crate::contact::ContactState;
 use crate::contact::kinematics::{
@@ -60,7 +61,7 @@ pub(crate) fn block_terms(
         .enumerate()
         .with_min_len(PAR_BLOCKS)
         .map(|(i, b)| {
-            if held.get(i).copied().unwrap_or(false) {
+            if is_held(held, i) {
                 return (Mat12::zeros(), Vec12::zeros());
             }
             let t = one_block(p, b, scheme, &b.kinematics(), dt);

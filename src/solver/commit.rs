@@ -6,6 +6,7 @@ use nalgebra::Vector6;
 use rayon::prelude::*;
 
 use super::active::Active;
+use super::sleep::is_held;
 use super::{PAR_BLOCKS, PAR_CONTACTS};
 use crate::contact::record::{ContactRecord, RecordMap};
 use crate::contact::{ContactKey, ContactState};
@@ -139,7 +140,7 @@ pub(crate) fn commit_blocks(
         .par_iter_mut()
         .with_min_len(PAR_BLOCKS)
         .enumerate()
-        .filter(|(i, _)| !held.get(*i).copied().unwrap_or(false))
+        .filter(|&(i, _)| !is_held(held, i))
         .for_each(|(i, b)| {
             let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
             b.set_kinematics(scheme.advance(&b.kinematics(), &di, dt));
@@ -165,7 +166,7 @@ pub(crate) fn commit_blocks(
 /// The step's statistics from its contacts: the largest penetration and kept overlap of a
 /// closed contact, and the contacts by state.
 pub(crate) fn contact_stats(active: &[Active], closed: &[ContactSnapshot]) -> StepStats {
-    let count = |s: ContactState| closed.iter().filter(|c| c.state == s).count() as u32;
+    let (contacts_lock, contacts_slide) = lock_and_slide(closed);
     StepStats {
         max_penetration: active
             .iter()
@@ -177,11 +178,17 @@ pub(crate) fn contact_stats(active: &[Active], closed: &[ContactSnapshot]) -> St
             .filter(|c| c.rec.state.is_closed())
             .map(|c| c.rec.overlap)
             .fold(0.0, f64::max),
-        contacts_lock: count(ContactState::Lock),
-        contacts_slide: count(ContactState::Slide),
+        contacts_lock,
+        contacts_slide,
         contacts_open: (active.len() - closed.len()) as u32,
         ..Default::default()
     }
+}
+
+/// How many of the closed contacts `closed` are locked, and how many slide.
+pub(crate) fn lock_and_slide(closed: &[ContactSnapshot]) -> (u32, u32) {
+    let count = |s: ContactState| closed.iter().filter(|c| c.state == s).count() as u32;
+    (count(ContactState::Lock), count(ContactState::Slide))
 }
 
 /// The kinetic, gravitational and elastic energy the blocks would have after the solution `d`

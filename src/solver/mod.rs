@@ -36,7 +36,7 @@ use sleep::Sleep;
 use step_control::Retry;
 use watchdog::{EnergyWatch, step_gain_limit};
 
-use crate::contact::groups::{Bounds, ContactGroups};
+use crate::contact::groups::ContactGroups;
 use crate::contact::record::RecordMap;
 use crate::model::Model;
 use crate::params::{Mode, SolverParams};
@@ -114,13 +114,7 @@ pub struct Solver {
 impl Solver {
     pub fn new(model: Model, params: SolverParams) -> Self {
         let initial_boxes: Vec<_> = model.blocks.iter().map(|b| (b.lo, b.hi)).collect();
-        let bounds = model
-            .blocks
-            .iter()
-            .zip(&initial_boxes)
-            .map(|(b, &home)| Bounds::of(b, home))
-            .collect();
-        let w0 = ContactGroups::find(bounds, params.max_displacement_ratio).largest_w0();
+        let w0 = contact_groups(&params, &model.blocks, &initial_boxes).largest_w0();
         let mut model = model;
         let sleep = Sleep::new(model.blocks.len());
         let stage = params
@@ -413,19 +407,8 @@ impl Solver {
     /// Stage 1: this step's contacts (none between two `held` blocks), and the global matrix
     /// laid out on their pattern.
     fn detect(&mut self, groups: &ContactGroups, held: &[bool]) -> (Vec<Active>, BlockMatrix) {
-        let mut active = activate_awake(
-            &ActivationInputs {
-                params: &self.params,
-                blocks: &self.model.blocks,
-                records: &self.records,
-                step: self.step,
-                time: self.time,
-                dt: self.dt,
-            },
-            groups,
-            held,
-        );
-        // Pairs of two sleeping blocks leave the pattern: they hold no contact.
+        // Pairs of two sleeping blocks are neither searched nor in the pattern: they hold no
+        // contact this step.
         let awake_near: Vec<(usize, usize)>;
         let near: &[(usize, usize)] = if held.is_empty() {
             &groups.pairs
@@ -438,6 +421,18 @@ impl Solver {
                 .collect();
             &awake_near
         };
+        let mut active = activate_awake(
+            &ActivationInputs {
+                params: &self.params,
+                blocks: &self.model.blocks,
+                records: &self.records,
+                step: self.step,
+                time: self.time,
+                dt: self.dt,
+            },
+            groups,
+            near,
+        );
         let pairs = assemble::sparsity_pattern(&active, &self.linear.pattern, near);
         let n = self.model.blocks.len();
         let kmat = match self.linear.matrix.take() {

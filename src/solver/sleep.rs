@@ -30,12 +30,16 @@
 
 use super::active::Active;
 use super::{Solver, commit, step_control};
-use crate::contact::ContactState;
 use crate::contact::groups::ContactGroups;
 use crate::contact::record::RecordMap;
 use crate::params::Mode;
 use crate::physics::integrator::Kinematics;
 use crate::snapshot::{ContactSnapshot, StepStats};
+
+/// Whether block `i` is held by `held` (the sleeping blocks of a step; empty: none).
+pub(crate) fn is_held(held: &[bool], i: usize) -> bool {
+    held.get(i).copied().unwrap_or(false)
+}
 
 /// Which blocks sleep, and how long each has been still.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -82,7 +86,7 @@ impl Sleep {
 
     /// Whether block `i` sleeps in the step under way.
     pub fn is_asleep(&self, i: usize) -> bool {
-        self.asleep.get(i).copied().unwrap_or(false)
+        is_held(&self.asleep, i)
     }
 
     /// Whether each block sleeps in the step under way.
@@ -199,16 +203,16 @@ impl Solver {
                 records.insert(*k, *r);
             }
         }
-        for c in &self.contacts {
-            if held[c.block_i] && held[c.block_j] {
-                contacts.push(c.clone());
-                match c.state {
-                    ContactState::Lock => stats.contacts_lock += 1,
-                    ContactState::Slide => stats.contacts_slide += 1,
-                    ContactState::Open => {}
-                }
-            }
-        }
+        let first = contacts.len();
+        contacts.extend(
+            self.contacts
+                .iter()
+                .filter(|c| held[c.block_i] && held[c.block_j])
+                .cloned(),
+        );
+        let (lock, slide) = commit::lock_and_slide(&contacts[first..]);
+        stats.contacts_lock += lock;
+        stats.contacts_slide += slide;
         stats.blocks_asleep = held.iter().filter(|&&h| h).count() as u32;
     }
 
@@ -237,11 +241,11 @@ impl Solver {
     /// forces. Returns the step taken.
     pub(super) fn rest(&mut self, dt: f64, base: f64, predicted: f64) -> f64 {
         self.sleep.resting = Some(predicted);
-        let count = |s| self.contacts.iter().filter(|c| c.state == s).count() as u32;
+        let (contacts_lock, contacts_slide) = commit::lock_and_slide(&self.contacts);
         let stats = StepStats {
             time_step: dt,
-            contacts_lock: count(ContactState::Lock),
-            contacts_slide: count(ContactState::Slide),
+            contacts_lock,
+            contacts_slide,
             blocks_asleep: self.model.blocks.len() as u32,
             ..Default::default()
         };

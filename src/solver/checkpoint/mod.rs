@@ -217,52 +217,35 @@ mod tests {
     /// with the original when the rock dropped on it comes near.
     #[test]
     fn a_sleeping_column_is_restored_asleep() {
-        let text = r#"
-[solver]
-duration = 2.0
-[materials.rock]
-density = 2750.0
-young_modulus = 2.0e10
-poisson_ratio = 0.25
-[[blocks]]
-name = "ground"
-material = "rock"
-fixed = true
-box = { size = [8, 8, 1], center = [0, 0, -0.5] }
-[[blocks]]
-name = "lower"
-material = "rock"
-box = { size = [1.2, 1.2, 2], center = [0, 0, 1] }
-[[blocks]]
-name = "upper"
-material = "rock"
-box = { size = [1.2, 1.2, 2], center = [0, 0, 3] }
-[[blocks]]
-name = "rock"
-material = "rock"
-box = { size = [0.8, 0.8, 0.8], center = [0, 0, 9] }
-"#;
-        let s = scene::parse(text, "column.toml", "column").unwrap();
+        // A generated column of three blocks (the lowest fixed by its springs), standing, and
+        // a cube 4.6 m above it.
+        let standing = crate::generate::column_wall(3, 3, false);
+        let text = format!(
+            "{standing}\n[[blocks]]\nname = \"rock\"\nmaterial = \"rock\"\n\
+             box = {{ size = [0.8, 0.8, 0.8], center = [0, 0, 11] }}\n"
+        );
+        let s = scene::parse(&text, "column.toml", "column").unwrap();
+        let (column, rock) = ([2, 3], 4);
         let mut a = Solver::new(s.model, s.params);
-        while !a.is_asleep(1) {
+        while !a.is_asleep(column[0]) {
             a.step().unwrap();
             assert!(a.time < 0.8, "the column sleeps before the rock comes near");
         }
         let mut b = decode(&encode(&a)).unwrap();
-        assert!(b.is_asleep(1) && b.is_asleep(2) && !b.is_asleep(3));
+        assert!(column.iter().all(|&i| b.is_asleep(i)) && !b.is_asleep(rock));
         assert_eq!(fingerprint(&a), fingerprint(&b));
         let mut woken = false;
         while a.time < 1.5 {
             a.step().unwrap();
             b.step().unwrap();
-            woken |= !a.is_asleep(1);
+            woken |= !a.is_asleep(column[0]);
         }
         assert!(woken, "the rock wakes the column");
         assert_eq!(fingerprint(&a), fingerprint(&b));
         // Without the rock everything sleeps, and a restored solver goes on resting with the
         // same steps.
-        let column = &text[..text.find("name = \"rock\"").unwrap() - "[[blocks]]\n".len()];
-        let s = scene::parse(column, "column.toml", "column").unwrap();
+        let column = crate::generate::column_wall(3, 3, false);
+        let s = scene::parse(&column, "column.toml", "column").unwrap();
         let mut a = Solver::new(s.model, s.params);
         while a.sleep.resting().is_none() {
             a.step().unwrap();
