@@ -329,28 +329,37 @@ impl SparseCholesky {
         // column block starts with its diagonal entries, rows c..12 (12 − c of them), followed
         // by the 12 rows of each off-diagonal block.
         let cp = &self.col_ptr;
+        // Column c of a 12×12 block is the contiguous slice [12c, 12c + 12) of its
+        // column-major storage, so the lower part of a diagonal block and an untransposed
+        // off-diagonal block go over column by column as slices.
         for (old, d) in k.diag.iter().enumerate() {
             let j = self.position[old];
+            let ds = d.as_slice();
             for c in 0..12 {
                 let base = cp[12 * j + c];
-                for r in c..12 {
-                    self.values[base + r - c] = d[(r, c)];
-                }
+                self.values[base..base + 12 - c].copy_from_slice(&ds[13 * c..12 * c + 12]);
             }
         }
         for (blk, at) in k.off.iter().zip(&self.pair_slot) {
+            let bs = blk.as_slice();
             for c in 0..12 {
                 let base = cp[12 * at.column + c] + (12 - c) + 12 * at.slot;
-                for r in 0..12 {
-                    self.values[base + r] = if at.transposed {
-                        blk[(c, r)]
-                    } else {
-                        blk[(r, c)]
-                    };
+                let column = &mut self.values[base..base + 12];
+                if at.transposed {
+                    for (r, v) in column.iter_mut().enumerate() {
+                        *v = bs[12 * r + c];
+                    }
+                } else {
+                    column.copy_from_slice(&bs[12 * c..12 * c + 12]);
                 }
             }
         }
-        if self.values.iter().any(|v| !v.is_finite()) {
+        // Without a short cut, so that the test runs over the values in wide lanes.
+        let not_finite = self
+            .values
+            .iter()
+            .fold(false, |bad, v| bad | !v.is_finite());
+        if not_finite {
             return Err(SolveError::NotPositiveDefinite);
         }
         let par = self.par();
