@@ -24,8 +24,9 @@
 //! the last step's statistics, the run's totals (without the wall-clock timings), the
 //! equilibrium stage (if under way) and its report, whether the blocks carry accelerations, and
 //! the energy watch, and each block's still time and whether it sleeps (version 2; version 1
-//! had no sleeping blocks and the two sleep parameters). Sorting the records and encoding nothing that depends on memory addresses,
-//! hash order or the clock makes the same state give the same bytes in every process.
+//! had no sleeping blocks and the two sleep parameters). Sorting the records and encoding
+//! nothing that depends on memory addresses, hash order or the clock makes the same state give
+//! the same bytes in every process.
 //!
 //! What a block derives from its vertices and the factorization are recomputed on loading (see
 //! [`state`]). The mirrors in [`state`] fail to compile when the type they mirror gains a

@@ -187,6 +187,7 @@ impl SavedSolver {
             .map(|(k, r)| (*k, SavedRecord::of(r)))
             .collect();
         records.sort_unstable_by_key(|(k, _)| *k);
+        let (still, asleep, resting) = sleep.parts();
         SavedSolver {
             params: SavedParams::of(params),
             model_name: model.name.clone(),
@@ -213,9 +214,9 @@ impl SavedSolver {
             equilibrium: *equilibrium,
             accelerations: *accelerations,
             energy: energy.clone(),
-            still: sleep.parts().0.to_vec(),
-            asleep: sleep.parts().1.to_vec(),
-            resting: sleep.parts().2,
+            still: still.to_vec(),
+            asleep: asleep.to_vec(),
+            resting,
         }
     }
 
