@@ -94,11 +94,11 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
     if c.rec.state == before {
         return (false, 0);
     }
+    c.changed = true;
+    c.flips += 1;
     if debug_log() {
         log_change(inp, c, before);
     }
-    c.changed = true;
-    c.flips += 1;
     let mut frozen = 0;
     let max_flips = match inp.params.method {
         Method::Alm => MAX_FLIPS,
@@ -223,22 +223,33 @@ fn close(inp: &CheckInputs, c: &mut Active) {
     c.rec.normal_force = 0.0;
 }
 
-/// `DDA3D_DEBUG=1`: one line per state change.
+/// `DDA3D_DEBUG=1`: one line per state change: the pass, the change, the contact's values from
+/// the solve, its changes so far in the attempt (`flips`, this one included), its state when the
+/// step began, and the contact itself (blocks, mode and features), which
+/// `scripts/open-close-tail.py` reads.
 fn log_change(inp: &CheckInputs, c: &Active, before: ContactState) {
+    let k = &c.cand.key;
     eprintln!(
-        "t={:.4} dt={:.2e} pass {}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} pair={}-{}",
+        "t={:.4} dt={:.2e} pass {}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} pair={}-{} flips={} started={:?} contact={}-{}/{}/{}-{}",
         inp.time,
         inp.dt,
         inp.pass,
         before,
         c.rec.state,
-        c.cand.key.mode,
+        k.mode,
         c.force,
         c.dn,
         c.rec.penalty,
         c.shear.norm(),
         c.slip.norm(),
-        c.cand.key.i,
-        c.cand.key.j
+        k.i,
+        k.j,
+        c.flips,
+        c.start.state,
+        k.i,
+        k.j,
+        k.mode,
+        k.feature_i,
+        k.feature_j
     );
 }
