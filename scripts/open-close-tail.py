@@ -7,8 +7,8 @@ Prints the state changes of each pass (over all steps), the changes from pass TA
 (default 8: "the tail") by kind, and how many of them were a contact's first change of its
 step, the steps with the most passes with their changes pass by pass, and the contacts that
 changed most often within one step. Lines are those of `log_change` in
-src/solver/open_close.rs; older logs without the `contact=` field are read by pair and mode,
-which lumps the contacts of one block pair together.
+src/solver/open_close.rs; a contact is its pair, mode and features (older logs without the
+`features=` field lump the contacts of one pair and mode together).
 """
 import collections
 import re
@@ -18,7 +18,7 @@ import sys
 LINE = re.compile(
     r"t=(?P<t>\S+) dt=\S+ pass (?P<pass>\d+): (?P<old>\w+)->(?P<new>\w+) mode=(?P<mode>\d)"
     r".* pair=(?P<pair>\S+)(?: flips=(?P<flips>\d+) started=(?P<started>\w+)"
-    r" contact=(?P<contact>\S+))?"
+    r" features=(?P<features>\S+))?"
 )
 
 
@@ -39,7 +39,7 @@ def main():
                 continue
             p = int(m["pass"])
             kind = f"{m['old']}->{m['new']}"
-            contact = m["contact"] or f"{m['pair']}/{m['mode']}"
+            contact = f"{m['pair']}/{m['mode']}" + (f"/{m['features']}" if m["features"] else "")
             per_pass[p] += 1
             by_step[m["t"]][p] += 1
             history[(m["t"], contact)].append((p, kind))

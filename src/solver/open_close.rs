@@ -225,12 +225,12 @@ fn close(inp: &CheckInputs, c: &mut Active) {
 
 /// `DDA3D_DEBUG=1`: one line per state change: the pass, the change, the contact's values from
 /// the solve, its changes so far in the attempt (`flips`, this one included), its state when the
-/// step began, and the contact itself (blocks, mode and features), which
-/// `scripts/open-close-tail.py` reads.
+/// step began, and its features, which with its pair and mode name the contact
+/// (`scripts/open-close-tail.py` reads them).
 fn log_change(inp: &CheckInputs, c: &Active, before: ContactState) {
     let k = &c.cand.key;
     eprintln!(
-        "t={:.4} dt={:.2e} pass {}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} pair={}-{} flips={} started={:?} contact={}-{}/{}/{}-{}",
+        "t={:.4} dt={:.2e} pass {}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} pair={}-{} flips={} started={:?} features={}-{}",
         inp.time,
         inp.dt,
         inp.pass,
@@ -246,9 +246,6 @@ fn log_change(inp: &CheckInputs, c: &Active, before: ContactState) {
         k.j,
         c.flips,
         c.start.state,
-        k.i,
-        k.j,
-        k.mode,
         k.feature_i,
         k.feature_j
     );
