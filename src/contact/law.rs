@@ -10,8 +10,8 @@
 //! - a closed contact opens under tension beyond p_n,1·f0·w0 (Shi's gap test f0·w0, as a force,
 //!   with the initial penalty so that a stiffened contact cannot hold tension);
 //! - a locked contact slides when its shear spring force exceeds N tan φ + c·A (Mohr–Coulomb;
-//!   cohesion only while the joint is intact), and only when the spring's shear displacement
-//!   exceeds f0·w0 (hysteresis for contacts that carry no load);
+//!   cohesion only while the joint is intact), and, unless it carries load, only when the
+//!   spring's shear displacement exceeds f0·w0 (hysteresis for contacts that carry no load);
 //! - a sliding contact sticks again when its slip reverses, or stops (if it was sliding when the
 //!   step began); otherwise its friction turns toward the slip, by the trial force (Cundall's
 //!   incremental friction, [`turned`]).
@@ -29,6 +29,10 @@ pub struct LawParams {
     /// Tangential displacements below this are neither slip nor a reversal of slip, m
     /// (`open_threshold · w0`, Shi's f0·w0).
     pub slip_tolerance: f64,
+    /// A closed contact pressed by at least this normal force carries load, N: it slides by
+    /// Mohr–Coulomb alone, whatever its spring's extension against `slip_tolerance` (see
+    /// [`LOADED_FRACTION`]). Infinite where no weight gives the scale (no gravity).
+    pub loaded_force: f64,
     /// tan φ of the joint.
     pub tan_phi: f64,
     /// Joints held against sliding (the equilibrium stage's first phase): a locked contact
@@ -41,6 +45,17 @@ pub struct LawParams {
     /// diverged).
     pub close_sliding: bool,
 }
+
+/// The share of the lighter free block's weight from which a contact counts as carrying load
+/// ([`LawParams::loaded_force`]). The slip tolerance f0·w0 keeps a contact that carries no
+/// load from sliding on the noise of its spring; but f0·w0 scales with the model (w0 is half
+/// the extent of the contact group), while a loaded spring's extension N tan φ / p_τ scales
+/// with the block's weight. Held to f0·w0, a 10 cm block on a 7.8 m slope could not slide
+/// even without friction: each corner's spring, 1.1 N of shear at p_τ = 8·10⁷ N/m, stretched
+/// 1.4·10⁻⁸ m against f0·w0 = 7.8·10⁻⁷ m, and blocks up to about 40 kg stood on any slope. A
+/// block resting on four corners presses each with about a quarter of its weight; a contact
+/// grazing it, with next to nothing.
+pub const LOADED_FRACTION: f64 = 0.01;
 
 /// What the last solve says of one contact.
 #[derive(Clone, Copy, Debug)]
@@ -107,7 +122,8 @@ pub fn classify(o: &Observation, p: &LawParams) -> Transition {
         ContactState::Lock => {
             let extension = o.shear.norm();
             let strength = o.normal_force * p.tan_phi + o.cohesion;
-            if extension > p.slip_tolerance && o.shear_stiffness * extension > strength {
+            let beyond_noise = extension > p.slip_tolerance || o.normal_force >= p.loaded_force;
+            if beyond_noise && o.shear_stiffness * extension > strength {
                 Transition::Slide {
                     tau: o.shear.normalize(),
                 }
@@ -211,6 +227,7 @@ mod tests {
             close_penetration: 1e-6,
             open_tension: 100.0,
             slip_tolerance: 1e-6,
+            loaded_force: f64::INFINITY,
             tan_phi: 35f64.to_radians().tan(),
             held: false,
             close_sliding: true,
@@ -308,6 +325,45 @@ mod tests {
                 );
             }
         }
+    }
+
+    /// A contact carrying load slides by Mohr–Coulomb alone, however short its spring; one
+    /// carrying less than `loaded_force` (or no weight to scale it: infinite) keeps the slip
+    /// tolerance's hysteresis. Over a family of normal forces and friction angles.
+    #[test]
+    fn a_loaded_contact_slides_below_the_slip_tolerance() {
+        for phi in [0.0f64, 10.0, 30.0] {
+            for n in [1.0, 10.0, 50.0] {
+                let p = LawParams {
+                    tan_phi: phi.to_radians().tan(),
+                    loaded_force: 0.5 * n,
+                    ..law()
+                };
+                let mut o = seen(ContactState::Lock);
+                o.normal_force = n;
+                // 10 % beyond the strength (1 µN without friction), well below f0·w0 = 1 µm.
+                let extension = (1.1 * n * p.tan_phi).max(1e-6) / o.shear_stiffness;
+                assert!(extension < p.slip_tolerance, "φ {phi}, N {n}");
+                o.shear = Vec3::new(0.0, extension, 0.0);
+                let slide = Transition::Slide { tau: Vec3::y() };
+                assert_eq!(classify(&o, &p), slide, "loaded: φ {phi}, N {n}");
+                let unloaded = LawParams {
+                    loaded_force: 2.0 * n,
+                    ..p
+                };
+                assert_eq!(classify(&o, &unloaded), Transition::Keep, "φ {phi}, N {n}");
+                assert_eq!(classify(&o, &law_at(p.tan_phi)), Transition::Keep);
+                // Within its strength it stays locked, loaded or not.
+                if phi > 0.0 {
+                    o.shear = Vec3::new(0.0, 0.9 * n * p.tan_phi / o.shear_stiffness, 0.0);
+                    assert_eq!(classify(&o, &p), Transition::Keep, "φ {phi}, N {n}");
+                }
+            }
+        }
+    }
+
+    fn law_at(tan_phi: f64) -> LawParams {
+        LawParams { tan_phi, ..law() }
     }
 
     #[test]

@@ -116,6 +116,11 @@ impl Active {
             close_penetration,
             open_tension: cp.initial_penalty * (cp.open_threshold * self.w0),
             slip_tolerance: cp.open_threshold * self.w0,
+            loaded_force: if self.weight > 0.0 {
+                law::LOADED_FRACTION * self.weight
+            } else {
+                f64::INFINITY
+            },
             tan_phi: self.tan_phi(p),
             held: p.joints_held,
             close_sliding: p.method == Method::Alm,
