@@ -61,6 +61,12 @@ pub(crate) struct EnergyWatch {
 }
 
 impl EnergyWatch {
+    /// Its balance holds finite numbers (a restored checkpoint's is checked).
+    pub fn is_finite(&self) -> bool {
+        let values = [self.available, self.work, self.work_scale];
+        self.start.iter().chain(&values).all(|v| v.is_finite())
+    }
+
     /// Starts the balance from the blocks as they are; `stats` holds their energies.
     pub fn begin(blocks: &[Block], gravity: [f64; 3], stats: &StepStats) -> Self {
         let g = Vec3::from(gravity);

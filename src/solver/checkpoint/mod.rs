@@ -42,7 +42,7 @@
 
 mod state;
 
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use state::SavedSolver;
@@ -132,12 +132,70 @@ pub fn decode(bytes: &[u8]) -> Result<Solver, CheckpointError> {
             rest.len()
         )));
     }
-    saved.into_solver().map_err(CheckpointError::Corrupt)
+    let solver = saved.into_solver().map_err(CheckpointError::Corrupt)?;
+    match not_finite(&solver) {
+        Some(what) => Err(CheckpointError::Corrupt(format!("{what} is not finite"))),
+        None => Ok(solver),
+    }
 }
 
-/// Reads the checkpoint at `path`.
+/// The first value of a restored state that is not a finite number, if any: the run's clock and
+/// step, the blocks' materials, geometry and motion, and the contacts' published values. A file
+/// whose checksum was made to match a state holding inf ran to its end and wrote `inf` into
+/// `contacts.csv`.
+fn not_finite(solver: &Solver) -> Option<String> {
+    let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+    if !finite(&[solver.time, solver.dt, solver.w0]) {
+        return Some("the run's time or step".into());
+    }
+    for b in &solver.model.blocks {
+        let m = &b.material;
+        if !finite(&[m.density, m.young_modulus, m.poisson_ratio, b.mass]) {
+            return Some(format!("block {}'s material", b.name));
+        }
+    }
+    let snap = solver.snapshot();
+    for b in &snap.blocks {
+        let corners = b.vertices.iter().flatten().copied();
+        let motion = [b.centroid, b.velocity, b.displacement]
+            .into_iter()
+            .flatten();
+        if !corners.chain(motion).chain(b.stress).all(f64::is_finite) {
+            return Some(format!("block {}'s state", b.name));
+        }
+    }
+    for c in &snap.contacts {
+        let values = [c.normal_force, c.shear_force, c.penetration, c.penalty];
+        let vectors = [c.point, c.normal, c.shear].into_iter().flatten();
+        if !vectors.chain(values).all(f64::is_finite) {
+            return Some(format!("a contact of {} and {}", c.block_i, c.block_j));
+        }
+    }
+    None
+}
+
+/// Reads the checkpoint at `path`: its header first, then no more than the payload length the
+/// header gives. (Read whole, `/dev/zero` filled the memory before anything was checked.)
 pub fn load(path: &Path) -> Result<Solver, CheckpointError> {
-    let bytes = std::fs::read(path).map_err(|e| CheckpointError::Read(e.to_string()))?;
+    let read = |e: std::io::Error| CheckpointError::Read(e.to_string());
+    let mut file = std::fs::File::open(path).map_err(read)?;
+    let mut bytes = Vec::with_capacity(HEADER);
+    (&mut file)
+        .take(HEADER as u64)
+        .read_to_end(&mut bytes)
+        .map_err(read)?;
+    // The header alone tells a foreign file, another version and a truncated header (decode
+    // finds the payload missing past that).
+    match decode(&bytes) {
+        Err(e @ (CheckpointError::Foreign | CheckpointError::Version { .. })) => return Err(e),
+        Err(e) if bytes.len() < HEADER => return Err(e),
+        _ => {}
+    }
+    let length = u64::from_le_bytes(bytes[20..28].try_into().expect("8 bytes"));
+    // One byte more than the header says, to tell a longer file from a whole one.
+    file.take(length.saturating_add(1))
+        .read_to_end(&mut bytes)
+        .map_err(read)?;
     decode(&bytes)
 }
 
@@ -348,6 +406,43 @@ mod tests {
             matches!(&e, CheckpointError::Corrupt(m) if m.contains("names block")),
             "{e}"
         );
+    }
+
+    /// A state holding inf or NaN under a checksum that matches it is refused as corrupt.
+    #[test]
+    fn a_state_that_is_not_finite_is_refused() {
+        let a = rockfall();
+        for value in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let mut saved = SavedSolver::of(&a);
+            saved.poison_for_tests(value);
+            let payload = postcard::to_allocvec(&saved).unwrap();
+            let mut bytes = encode(&a)[..HEADER].to_vec();
+            bytes[20..28].copy_from_slice(&(payload.len() as u64).to_le_bytes());
+            bytes[28..32].copy_from_slice(&crc32fast::hash(&payload).to_le_bytes());
+            bytes.extend_from_slice(&payload);
+            let e = decode(&bytes).err().expect("refused");
+            assert!(
+                matches!(&e, CheckpointError::Corrupt(m) if m.contains("not finite")),
+                "{value}: {e}"
+            );
+        }
+    }
+
+    /// `load` reads the header before the payload: an endless stream is refused at once.
+    #[test]
+    fn an_endless_file_is_refused_from_its_header() {
+        for path in ["/dev/zero", "/dev/urandom"] {
+            if Path::new(path).exists() {
+                assert_eq!(load(Path::new(path)).err(), Some(CheckpointError::Foreign));
+            }
+        }
+        // A whole checkpoint loads through the same path.
+        let dir = std::env::temp_dir().join(format!("dda3d-ckpt-load-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("a.ckpt");
+        save(&rockfall(), &file).unwrap();
+        assert!(load(&file).is_ok());
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 
     #[test]

@@ -11,6 +11,8 @@
 //! pattern on loading, its numbers at the next step as at every step), and the run's wall-clock
 //! timings, which are not state and would make every file different.
 
+mod finite;
+
 use std::sync::Arc;
 
 use serde::{Deserialize, Serialize};
@@ -318,7 +320,7 @@ impl SavedSolver {
         if self.records.windows(2).any(|w| w[0].0 >= w[1].0) {
             return Err("contact records out of order".into());
         }
-        Ok(())
+        self.check_finite()
     }
 }
 
@@ -641,6 +643,11 @@ impl SavedStage {
 #[cfg(test)]
 impl SavedSolver {
     /// Points a contact record at a block the model does not have.
+    /// Puts `value` into block 1's first velocity component (a test of the finiteness check).
+    pub(super) fn poison_for_tests(&mut self, value: f64) {
+        self.blocks[1].velocity[0] = value;
+    }
+
     pub(super) fn break_a_record_for_tests(&mut self) {
         let key = ContactKey {
             i: self.blocks.len() as u32,
