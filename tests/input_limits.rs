@@ -506,3 +506,83 @@ fn a_bench_scene_that_does_not_load_is_bad_input() {
         assert!(err.contains("bad.toml"), "{err}");
     }
 }
+
+/// A rock mass of one joint set, with `fixed` and `origin` as given (the set's line is 19).
+fn rock_mass(fixed: &str, spacing: f64, origin: &str) -> String {
+    format!(
+        "[materials.rock]\ndensity = 2600.0\nyoung_modulus = 1.0e10\npoisson_ratio = 0.25\n\
+         [[blocks]]\nname = \"ground\"\nmaterial = \"rock\"\nfixed = true\n\
+         box = {{ size = [20, 20, 2], center = [0, 0, -1] }}\n\
+         [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\n\
+         regions = [ {{ box = {{ size = [4, 4, 4], center = [0, 0, 2] }} }} ]\n\
+         fixed = {fixed}\n\
+         [[rock_masses.joint_sets]]\nname = \"J1\"\ndip = 45.0\ndip_direction = 90.0\n\
+         spacing = {spacing}\norigin = {origin}\n"
+    )
+}
+
+/// Rock masses: an origin too far out to resolve the spacing (wrong planes at 1e17 m, a walk
+/// that never ended at 1e300 m), and coordinate selectors that are not numbers, are bad input;
+/// an origin within 10⁹ spacings cuts the same blocks as one at the domain.
+#[test]
+fn rock_mass_origins_and_selectors_are_bounded() {
+    let dir = tmp("rock-mass-bounds");
+    for (spacing, origin) in [
+        (1.0, "[1e17, 0, 0]"),
+        (1.0, "[0, 0, -1e300]"),
+        (0.5, "[0, 1e9, 0]"),
+    ] {
+        let text = rock_mass("{ below = 1.0 }", spacing, origin);
+        let err = run_error(&dir, &text, origin);
+        assert!(err.contains("cannot resolve a spacing"), "{origin}: {err}");
+    }
+    for selector in ["below", "x_above", "y_below"] {
+        for value in ["nan", "inf", "-inf"] {
+            let text = rock_mass(&format!("{{ {selector} = {value} }}"), 1.0, "[0, 0, 0]");
+            let err = run_error(&dir, &text, selector);
+            assert!(
+                err.contains(&format!("fixed.{selector}")),
+                "{selector}: {err}"
+            );
+        }
+    }
+    let blocks = |origin: &str| {
+        let path = dir.join("good.toml");
+        std::fs::write(&path, rock_mass("{ below = 1.0 }", 1.0, origin)).unwrap();
+        let out = dir.join("cut.toml");
+        let status = bin()
+            .arg("cut")
+            .arg(&path)
+            .arg("--out")
+            .arg(&out)
+            .output()
+            .unwrap();
+        assert!(status.status.success(), "{origin}: {status:?}");
+        std::fs::read_to_string(&out)
+            .unwrap()
+            .matches("[[blocks]]")
+            .count()
+    };
+    assert_eq!(blocks("[1e9, 0, 0]"), blocks("[0, 0, 0]"));
+}
+
+/// `render`'s frame count, duration × fps, is bounded before anything is drawn (no GPU needed).
+#[test]
+fn render_frames_are_bounded() {
+    let dir = tmp("render-frames");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/slope_stable.toml");
+    for (duration, fps) in [("0.05", "1e9"), ("1000", "1000"), ("5000", "30")] {
+        let out = bin()
+            .arg("render")
+            .arg(&scene)
+            .args(["--quiet", "--duration", duration, "--fps", fps, "--out"])
+            .arg(dir.join("o"))
+            .output()
+            .unwrap();
+        let err = one_line_error(&out, fps);
+        assert!(
+            err.contains("frames, more than 100000"),
+            "{duration} s at {fps}: {err}"
+        );
+    }
+}

@@ -141,6 +141,7 @@ pub(super) fn capture_failure(out: &Path, e: RenderError) -> Failure {
 pub(super) fn execute(args: &RenderArgs) -> Result<(), Failure> {
     let scene = load_scene(&args.scene, &args.overrides)?;
     check_image_options(args)?;
+    check_frame_count(scene.params.duration, args.fps)?;
     if let Some(spec) = CompareSpec::parse(args.compare.as_deref(), args.compare_set.as_deref())
         .map_err(|e| Failure::Input(e.to_string()))?
     {
@@ -220,6 +221,26 @@ pub(super) fn conclude(
 /// `dda3d render`.
 pub fn render(args: &RenderArgs) -> Result<(), CliError> {
     execute(args).map_err(CliError::from)
+}
+
+/// The most frames a render writes (`--duration` × `--fps`): a day's worth at 1 s a frame
+/// on a software rasterizer, 100 GB of 1280×720 PNG. `--fps 1e9` over 0.05 s asked for 5·10⁷
+/// frames and wrote 200 MB a minute.
+pub(super) const MAX_FRAMES: f64 = 100_000.0;
+
+/// The frame count `duration` × `fps` (+1 for frame 0) is within [`MAX_FRAMES`].
+pub(super) fn check_frame_count(duration: f64, fps: f64) -> Result<(), CliError> {
+    let frames = duration * fps + 1.0;
+    if frames > MAX_FRAMES {
+        return Err(CliError::Input(format!(
+            "{} s at --fps {} would be {} frames, more than {}: lower --fps or --duration",
+            crate::text::short(duration),
+            crate::text::short(fps),
+            crate::text::short(frames.floor()),
+            crate::text::short(MAX_FRAMES)
+        )));
+    }
+    Ok(())
 }
 
 /// The checks of `--fps`, `--width`/`--height` and `--msaa` that need no GPU.

@@ -199,7 +199,7 @@ fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
 /// The line and message of a toml error: its line from its offset, and the key of the value it
 /// rejects where the message does not name it (`solver.gravity: expected 3 numbers, got 4`).
 fn toml_error(text: &str, e: &toml::de::Error) -> (Option<usize>, String) {
-    let message = e.message().trim().replace('\n', " ");
+    let message = shorten_numbers(&e.message().trim().replace('\n', " "));
     let Some(span) = e.span() else {
         return (None, message);
     };
@@ -208,6 +208,28 @@ fn toml_error(text: &str, e: &toml::de::Error) -> (Option<usize>, String) {
         Some(key) if !message.contains(&format!("`{key}`")) => (line, format!("{key}: {message}")),
         _ => (line, message),
     }
+}
+
+/// The message with every number of more than 12 characters written short: serde prints a
+/// float in full, 309 digits for `1e308` where an integer was expected.
+fn shorten_numbers(message: &str) -> String {
+    let is_num = |c: char| c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E');
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        let len = rest[start..]
+            .find(|c: char| !is_num(c))
+            .unwrap_or(rest.len() - start);
+        let token = &rest[start..start + len];
+        out.push_str(&rest[..start]);
+        match token.parse::<f64>() {
+            Ok(x) if token.len() > 12 => out.push_str(&crate::text::short(x)),
+            _ => out.push_str(token),
+        }
+        rest = &rest[start + len..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// The line of the first of `keys` (`solver.contact.beta`) that the text sets.
@@ -476,6 +498,20 @@ fn cut_block(b: CutBlock, material: Material) -> Result<Block, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn long_numbers_in_messages_are_written_short() {
+        let full = format!("invalid type: floating point `{}`, expected u32", 1e308f64);
+        assert_eq!(
+            shorten_numbers(&full),
+            "invalid type: floating point `1e308`, expected u32"
+        );
+        // Short numbers, line numbers and identifiers with digits stay as they are.
+        let kept = "line 12: max_alm_iterations: 20 is not in [1, 1000], x2 0.25";
+        assert_eq!(shorten_numbers(kept), kept);
+        let tiny = format!("got {:.320}", 1e-308f64);
+        assert_eq!(shorten_numbers(&tiny), "got 1e-308");
+    }
 
     const GOOD: &str = r#"
 name = "two cubes"

@@ -9,6 +9,10 @@
 
 use nalgebra::Vector3;
 
+/// The smallest spacing, relative to its origin's largest coordinate, that a joint set may
+/// have: f64's 16 digits, less a margin (as for a block's size against its coordinates).
+const ORIGIN_RESOLUTION: f64 = 1e-9;
+
 use super::build::shape_points;
 use super::format::{FixedSpec, JointSetSpec, PlanesSpec, RockMassSpec};
 use crate::model::{Block, JointFace, RockMassOf};
@@ -62,6 +66,7 @@ pub(super) fn cut_mass(
     default_joint: &JointParams,
     max_blocks: usize,
 ) -> Result<CutMass, String> {
+    check_fixed(&spec.fixed)?;
     let regions = regions(spec)?;
     let points: Vec<Vec3> = regions
         .iter()
@@ -247,6 +252,25 @@ fn off_hull_edges(
     })
 }
 
+/// `fixed`'s coordinate selectors are finite numbers (`below = nan` held no block, silently).
+fn check_fixed(fixed: &FixedSpec) -> Result<(), String> {
+    let limits = [
+        ("below", fixed.below),
+        ("above", fixed.above),
+        ("x_below", fixed.x_below),
+        ("x_above", fixed.x_above),
+        ("y_below", fixed.y_below),
+        ("y_above", fixed.y_above),
+    ];
+    match limits
+        .iter()
+        .find(|(_, v)| v.is_some_and(|v| !v.is_finite()))
+    {
+        Some((key, _)) => Err(format!("fixed.{key} must be a finite coordinate, m")),
+        None => Ok(()),
+    }
+}
+
 /// Whether a block of centroid `c` in `region` is held, by `fixed`'s selectors.
 fn is_fixed(fixed: &FixedSpec, c: &Vec3, region: usize) -> bool {
     let below = |limit: Option<f64>, x: f64| limit.is_some_and(|l| x < l);
@@ -334,6 +358,18 @@ fn set_geometry(set: &JointSetSpec) -> Result<SetGeometry, String> {
     }
     if set.origin.iter().any(|x| !x.is_finite()) {
         return Err(format!("joint set '{}': origin is not finite", set.name));
+    }
+    // The planes lie at n·o + k·spacing: an origin so far out that f64 cannot resolve the
+    // spacing there gives wrong planes (at 1e17 m, two blocks from 7 planes instead of 7 from
+    // 6), and farther still, a walk of 10^300 planes that never ends.
+    let reach = set.origin.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if reach * ORIGIN_RESOLUTION > set.spacing {
+        return Err(format!(
+            "joint set '{}': an origin {} m out cannot resolve a spacing of {} m; put the origin in or near the rock mass",
+            set.name,
+            crate::text::short(reach),
+            crate::text::short(set.spacing)
+        ));
     }
     Ok(SetGeometry {
         dip: set.dip,
