@@ -181,3 +181,35 @@ fn a_very_long_scene_name_still_runs() {
     let slug = made[0].as_ref().unwrap().file_name();
     assert!(slug.len() <= dda3d::output::MAX_SLUG, "{slug:?}");
 }
+
+/// A model of fixed blocks only (a rock mass cut into slabs, every one held, on a fixed ground)
+/// completes: its blocks settle on their vertex springs, and the elastic energy they store
+/// (3 µJ) was taken by the energy watchdog for a gain above its 1 µJ floor ("diverged").
+#[test]
+fn a_model_of_fixed_blocks_only_completes() {
+    let dir = fresh_dir("all_fixed");
+    let text = "[solver]\nduration = 0.05\n\
+        [materials.rock]\ndensity = 2600.0\nyoung_modulus = 1.0e10\npoisson_ratio = 0.25\n\
+        [[blocks]]\nname = \"ground\"\nmaterial = \"rock\"\nfixed = true\n\
+        box = { size = [20, 20, 2], center = [0, 0, -1] }\n\
+        [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\n\
+        regions = [ { box = { size = [4, 4, 4], center = [0, 0, 2] } } ]\n\
+        fixed = { below = 1e9 }\n\
+        [[rock_masses.joint_sets]]\nname = \"J1\"\ndip = 45.0\ndip_direction = 90.0\n\
+        spacing = 1.0\n";
+    let path = dir.join("held.toml");
+    std::fs::write(&path, text).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        .arg("run")
+        .arg(&path)
+        .args(["--quiet", "--out"])
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    let summary: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("out/summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["status"], "completed");
+}

@@ -66,8 +66,8 @@ solver.contact.shear_penalty_ratio: 1e300; solver.contact.close_threshold: 1e300
 solver.contact.max_alm_iterations: 1 | 1000000000 | 0! | 4294967296!
 solver.contact.max_open_close_iterations: 1 | 0!; solver.contact.open_threshold: -1.0!
 joint.friction_angle: 0.0 | 89.999999 | 90.0! | -1.0!; joint.cohesion: 1e308 | -1.0!
-materials.rock.density: -2750.0! | 0.0! | 1e-300 | 1e300 | 1e-9
-materials.rock.young_modulus: -2e10! | 0.0! | 1e-300 | 1e300 | 1.0
+materials.rock.density: -2750.0! | 0.0! | 1e-300! | 1e300! | 1e-9! | 0.01 | 2e5
+materials.rock.young_modulus: -2e10! | 0.0! | 1e-300! | 1e300! | 1.0! | 100.0 | 1e13
 materials.rock.poisson_ratio: 0.5! | 1.0! | -1.0! | 0.4999999 | -0.9999999 | 0.0 | nan!";
 
 /// Settings of one block (a shape of its own kind replaces it, another kind is a second shape).
@@ -85,7 +85,7 @@ material: \"soft\" | \"dense\" | \"no\\nsuch\"! | \"\"!
 name: \"\" | \"a\\nb\" | \"Ω ≈ ç √\" | \"\\u0000\" | \"../../x\" | LONG";
 
 const MATERIALS: &str = "{ soft = { density = 1.0, young_modulus = 1e3, poisson_ratio = 0.0 }, \
-    dense = { density = 1e300, young_modulus = 1e300, poisson_ratio = 0.49 } }";
+    dense = { density = 2e5, young_modulus = 1e13, poisson_ratio = 0.49 } }";
 
 /// Command-line values, as typed; `+` adds a flag.
 const CLI: &str = "

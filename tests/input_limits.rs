@@ -411,6 +411,35 @@ fn blocks_and_points_are_bounded() {
         );
         assert!(err.contains("prism: a base of"), "{err}");
     }
+    // Within the point limit, a hull of more than 4096 corners (points on a sphere, every one
+    // a corner) is refused too; one of 4000 loads.
+    let sphere = |n: usize| {
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        let points: Vec<String> = (0..n)
+            .map(|k| {
+                let z = 1.0 - 2.0 * (k as f64 + 0.5) / n as f64;
+                let r = (1.0 - z * z).sqrt();
+                let a = golden * k as f64;
+                format!("[{}, {}, {}]", r * a.cos(), r * a.sin(), z + 1.0)
+            })
+            .collect();
+        shaped(&format!("vertices = [{}]", points.join(",")))
+    };
+    let err = run_error(&dir, &sphere(5000), "hull");
+    assert!(
+        err.contains("convex hull has 5000 corners, more than the limit of 4096"),
+        "{err}"
+    );
+    let path = dir.join("sphere.toml");
+    std::fs::write(&path, sphere(4000)).unwrap();
+    let status = bin()
+        .arg("run")
+        .arg(&path)
+        .args(["--quiet", "--duration", "0.01", "--out"])
+        .arg(dir.join("s"))
+        .output()
+        .unwrap();
+    assert!(status.status.success(), "{status:?}");
 }
 
 /// `generate` writes only scenes that load, and `bench` checks its sizes before it builds any.

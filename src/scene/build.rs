@@ -2,8 +2,8 @@
 //! a convex hull, and the blocks checked for overlap at the start. Messages here are the problem
 //! alone; [`super::parse`] adds the file, the line and the block's name.
 
-use super::MAX_BLOCK_POINTS;
 use super::format::{BlockSpec, ShapeSpec};
+use super::{MAX_BLOCK_POINTS, MAX_HULL_VERTICES};
 use crate::contact::Shape;
 use crate::contact::detection::broad_phase;
 use crate::model::Block;
@@ -13,6 +13,11 @@ use crate::physics::geometry::{
 };
 use crate::physics::mechanics::Material;
 use crate::text::short;
+
+/// The densities a material may have, kg/m³: from a light foam to ten times osmium's.
+pub const DENSITY_RANGE: (f64, f64) = (1e-2, 2e5);
+/// The Young's moduli a material may have, Pa: from a soft gel to ten times diamond's.
+pub const YOUNG_RANGE: (f64, f64) = (1e2, 1e13);
 
 /// Checks a material's constants; an error names the key it concerns.
 pub(super) fn check_material(name: &str, m: &Material) -> Result<(), (&'static str, String)> {
@@ -28,23 +33,46 @@ pub(super) fn check_material(name: &str, m: &Material) -> Result<(), (&'static s
             ));
         }
     }
-    if m.density <= 0.0 {
-        return Err((
+    // Bounds far outside any rock (or any solid) that still keep the step's matrices
+    // representable: at a density of 1e308 or 1e-308 kg/m³, or E = 1e308 Pa, the first solve
+    // was not finite and the run was reported as diverged instead of the input as bad; at
+    // E = 1e-308 Pa a fixed block's springs held nothing and the ground fell.
+    for (key, v, lo, hi, unit) in [
+        (
             "density",
-            format!(
-                "material '{name}': density must be positive, got {}",
-                short(m.density)
-            ),
-        ));
-    }
-    if m.young_modulus <= 0.0 {
-        return Err((
+            m.density,
+            DENSITY_RANGE.0,
+            DENSITY_RANGE.1,
+            "kg/m³",
+        ),
+        (
             "young_modulus",
-            format!(
-                "material '{name}': young_modulus must be positive, got {}",
-                short(m.young_modulus)
-            ),
-        ));
+            m.young_modulus,
+            YOUNG_RANGE.0,
+            YOUNG_RANGE.1,
+            "Pa",
+        ),
+    ] {
+        if v <= 0.0 {
+            return Err((
+                key,
+                format!(
+                    "material '{name}': {key} must be positive, got {}",
+                    short(v)
+                ),
+            ));
+        }
+        if !(lo..=hi).contains(&v) {
+            return Err((
+                key,
+                format!(
+                    "material '{name}': {key} must lie in [{}, {}] {unit}, got {}",
+                    short(lo),
+                    short(hi),
+                    short(v)
+                ),
+            ));
+        }
     }
     if !(m.poisson_ratio > -1.0 && m.poisson_ratio < 0.5) {
         return Err((
@@ -143,6 +171,12 @@ pub(super) fn build_block(
 ) -> Result<Block, String> {
     let points = shape_points(&spec.shape())?;
     let (vertices, topo) = convex_hull(&points).map_err(|e| e.to_string())?;
+    if vertices.len() > MAX_HULL_VERTICES {
+        return Err(format!(
+            "its convex hull has {} corners, more than the limit of {MAX_HULL_VERTICES}: simplify the shape (contact detection tests every corner against every face)",
+            vertices.len()
+        ));
+    }
     if !finite(&spec.velocity) || !finite(&spec.angular_velocity) {
         return Err("velocity is not finite".into());
     }

@@ -63,6 +63,12 @@ pub const MAX_BLOCKS: usize = 100_000;
 /// hull of 10⁵ points takes well under a second in O(n log n), and a real block has tens.
 pub const MAX_BLOCK_POINTS: usize = 100_000;
 
+/// The most corners a block's convex hull may keep. Contact detection between two blocks
+/// tests every corner of each against the other's faces: two hulls of 10⁴ corners took 0.25 s
+/// a step, two of 10⁵ (inside the point limit) 50 s. A real block has tens; a scanned boulder
+/// is simplified to a few hundred.
+pub const MAX_HULL_VERTICES: usize = 4096;
+
 /// A bad scene: one line naming the file, the line when known, and the problem.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SceneError {
