@@ -30,6 +30,8 @@ pub(crate) struct AttemptInputs<'a> {
     pub at_floor: bool,
     /// The sleeping blocks, held where they are (empty: none).
     pub held: &'a [bool],
+    /// The step belongs to the initial equilibrium stage.
+    pub in_stage: bool,
 }
 
 /// The solution of one attempt at a step.
@@ -126,6 +128,7 @@ fn open_close_iteration(
             time: inp.time,
             dt: inp.dt,
             pass: solved.oc_passes,
+            onset_turns: p.method == Method::Alm && !inp.in_stage,
         };
         let changed = open_close::check(&check, &solved.d, active, counters);
         counters.assembly += watch.elapsed();

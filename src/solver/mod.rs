@@ -480,6 +480,7 @@ impl Solver {
                 first_step: self.step == 0,
                 at_floor,
                 held,
+                in_stage: self.stage.is_some(),
             };
             let result = attempt(&inputs, kmat, &mut self.linear.chol, active, &mut counters)
                 .and_then(|solved| {
