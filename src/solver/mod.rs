@@ -343,6 +343,13 @@ impl Solver {
             }
         }
         let groups = contact_groups(&self.params, &self.model.blocks, &self.initial_boxes);
+        let (pairs, delta) = (groups.pairs.len(), self.params.max_displacement_ratio);
+        if let Err(reason) = step_control::check_pair_count(pairs, groups.largest_w0(), delta) {
+            return Err(SolverError::Diverged {
+                time: self.time,
+                reason,
+            });
+        }
         self.w0 = groups.largest_w0();
         self.settle_sleep(&groups);
         let predicted = step_control::predict_dt(&self.params, &self.model.blocks, &groups);
