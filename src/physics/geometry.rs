@@ -18,6 +18,15 @@ pub enum GeometryError {
     NonFinite(usize),
     #[error("vertices are coplanar: the block has no volume")]
     Flat,
+    /// After merging the points closer than the hull's tolerance (10⁻⁷ of the block's size),
+    /// fewer than four are left: a needle or a sliver.
+    #[error(
+        "its points merge into {0} distinct corners (points closer than 1e-7 of its size are one): the block has no volume"
+    )]
+    Merged(usize),
+    /// A coordinate beyond [`MAX_COORDINATE`]: squared lengths overflow.
+    #[error("a vertex lies {} m out, beyond the {} m a coordinate may reach", short(*.0), short(MAX_COORDINATE))]
+    TooFar(f64),
     #[error("the convex hull is not a closed polyhedron")]
     NotClosed,
     /// The block is too small for its distance from the origin: its corners differ in digits
@@ -34,6 +43,11 @@ pub enum GeometryError {
 /// the hull's tolerance (1e-7 of the size) is under one unit in the last place of the
 /// coordinates (1.1e-16 of them), so flatness and contact could only be guessed.
 const RESOLUTION: f64 = 1e-9;
+
+/// The largest coordinate a vertex may have, m (1000 times the Earth's orbit). A vertex at
+/// 10³⁰⁸ m made the block's diagonal infinite and every point merge into one ("needs at least
+/// four vertices, got 1").
+pub const MAX_COORDINATE: f64 = 1e15;
 
 /// An edge of a polyhedron with the two faces that meet along it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,23 +93,26 @@ pub fn convex_hull(points: &[Vec3]) -> Result<(Vec<Vec3>, Topology), GeometryErr
     if points.len() < 4 {
         return Err(GeometryError::TooFewVertices(points.len()));
     }
+    let reach = points.iter().fold(0.0f64, |m, p| m.max(p.amax()));
     let (lo, hi) = bounding_box(points);
-    let diag = (hi - lo).norm();
-    if diag == 0.0 {
+    let size = (hi - lo).max();
+    if size == 0.0 {
         return Err(GeometryError::Flat);
     }
-    let reach = points.iter().fold(0.0f64, |m, p| m.max(p.amax()));
-    let size = (hi - lo).max();
     if size < RESOLUTION * reach {
         return Err(GeometryError::Unresolved { reach, size });
     }
+    if reach > MAX_COORDINATE {
+        return Err(GeometryError::TooFar(reach));
+    }
+    let diag = (hi - lo).norm();
     // Points closer than this to a plane are on it. Loose enough for coordinates typed with
     // four or five significant digits, tight enough to keep real faces apart.
     let tol = 1e-7 * diag;
     let pts = hull::dedup(points, &lo, tol);
     let n = pts.len();
     if n < 4 {
-        return Err(GeometryError::TooFewVertices(n));
+        return Err(GeometryError::Merged(n));
     }
     let faces = hull::faces(&pts, tol, diag)?;
     corners_only(&pts, faces)

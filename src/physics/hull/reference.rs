@@ -33,7 +33,7 @@ pub(super) fn convex_hull_reference(
     }
     let n = pts.len();
     if n < 4 {
-        return Err(GeometryError::TooFewVertices(n));
+        return Err(GeometryError::Merged(n));
     }
 
     // Supporting planes, each with the set of points lying on it.
