@@ -54,7 +54,9 @@ pub struct LawParams {
 /// even without friction: each corner's spring, 1.1 N of shear at p_τ = 8·10⁷ N/m, stretched
 /// 1.4·10⁻⁸ m against f0·w0 = 7.8·10⁻⁷ m, and blocks up to about 40 kg stood on any slope. A
 /// block resting on four corners presses each with about a quarter of its weight; a contact
-/// grazing it, with next to nothing.
+/// grazing it, with next to nothing. The same fraction bounds the tension that opens a contact
+/// ([`LawParams::open_tension`], set in `crate::solver::active`), for the same reason: a block
+/// that should topple stood on corners held by p_n,1·f0·w0 of tension.
 pub const LOADED_FRACTION: f64 = 0.01;
 
 /// What the last solve says of one contact.

@@ -114,7 +114,17 @@ impl Active {
         };
         LawParams {
             close_penetration,
-            open_tension: cp.initial_penalty * (cp.open_threshold * self.w0),
+            // Like the slip tolerance, p_n,1·f0·w0 scales with the contact group, not the
+            // block: held to it, a 0.3 × 0.3 × 1 m block on a 20 m slope that should topple
+            // (its corners under 120 N of tension against 400 N) stood. A block's own weight
+            // bounds it too (`law::LOADED_FRACTION` of the lighter block's).
+            open_tension: (cp.initial_penalty * (cp.open_threshold * self.w0)).min(
+                if self.weight > 0.0 {
+                    law::LOADED_FRACTION * self.weight
+                } else {
+                    f64::INFINITY
+                },
+            ),
             slip_tolerance: cp.open_threshold * self.w0,
             loaded_force: if self.weight > 0.0 {
                 law::LOADED_FRACTION * self.weight
