@@ -129,6 +129,7 @@ fn open_close_iteration(
             dt: inp.dt,
             pass: solved.oc_passes,
             onset_turns: p.method == Method::Alm && !inp.in_stage,
+            holding: &Default::default(),
         };
         let changed = open_close::check(&check, &solved.d, active, counters);
         counters.assembly += watch.elapsed();
