@@ -77,12 +77,17 @@ pub enum CheckpointError {
 pub fn encode(solver: &Solver) -> Vec<u8> {
     let payload = postcard::to_allocvec(&SavedSolver::of(solver))
         .expect("the solver state is plain data, which postcard always encodes");
+    framed(&payload)
+}
+
+/// `payload` behind the header: magic, version, its length and its checksum.
+fn framed(payload: &[u8]) -> Vec<u8> {
     let mut bytes = Vec::with_capacity(HEADER + payload.len());
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&VERSION.to_le_bytes());
     bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-    bytes.extend_from_slice(&crc32fast::hash(&payload).to_le_bytes());
-    bytes.extend_from_slice(&payload);
+    bytes.extend_from_slice(&crc32fast::hash(payload).to_le_bytes());
+    bytes.extend_from_slice(payload);
     bytes
 }
 
@@ -391,17 +396,18 @@ mod tests {
 
     /// A payload whose checksum holds but whose state does not (a writer's bug, or a forged
     /// file) is refused, not stepped.
+    /// A whole checkpoint of `saved`, its header's length and checksum made to match it (a
+    /// forged file).
+    fn with_checksum(saved: &SavedSolver) -> Vec<u8> {
+        framed(&postcard::to_allocvec(saved).unwrap())
+    }
+
     #[test]
     fn a_state_that_does_not_hold_together_is_refused() {
         let a = rockfall();
         let mut saved = SavedSolver::of(&a);
         saved.break_a_record_for_tests();
-        let payload = postcard::to_allocvec(&saved).unwrap();
-        let mut bytes = encode(&a)[..HEADER].to_vec();
-        bytes[20..28].copy_from_slice(&(payload.len() as u64).to_le_bytes());
-        bytes[28..32].copy_from_slice(&crc32fast::hash(&payload).to_le_bytes());
-        bytes.extend_from_slice(&payload);
-        let e = decode(&bytes).err().expect("refused");
+        let e = decode(&with_checksum(&saved)).err().expect("refused");
         assert!(
             matches!(&e, CheckpointError::Corrupt(m) if m.contains("names block")),
             "{e}"
@@ -415,12 +421,7 @@ mod tests {
         for value in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
             let mut saved = SavedSolver::of(&a);
             saved.poison_for_tests(value);
-            let payload = postcard::to_allocvec(&saved).unwrap();
-            let mut bytes = encode(&a)[..HEADER].to_vec();
-            bytes[20..28].copy_from_slice(&(payload.len() as u64).to_le_bytes());
-            bytes[28..32].copy_from_slice(&crc32fast::hash(&payload).to_le_bytes());
-            bytes.extend_from_slice(&payload);
-            let e = decode(&bytes).err().expect("refused");
+            let e = decode(&with_checksum(&saved)).err().expect("refused");
             assert!(
                 matches!(&e, CheckpointError::Corrupt(m) if m.contains("not finite")),
                 "{value}: {e}"
