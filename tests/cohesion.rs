@@ -7,27 +7,11 @@
 //! share the load evenly.)
 
 use dda3d::params::Method;
-use dda3d::scene;
-use dda3d::solver::Solver;
+
+mod travel_support;
+use travel_support::travel;
 
 const PHI: f64 = 20.0;
-
-/// The block's centroid travel after `duration` s.
-fn travel(text: &str, method: Method, duration: f64) -> f64 {
-    let mut s = scene::parse(text, "cohesion.toml", "cohesion").expect("scene parses");
-    s.params.method = method;
-    s.params.duration = duration;
-    let mut solver = Solver::new(s.model, s.params);
-    let start = solver.snapshot().blocks[1].centroid;
-    while !solver.finished() {
-        solver.step().expect("runs");
-    }
-    let end = solver.snapshot().blocks[1].centroid;
-    (0..3)
-        .map(|k| (end[k] - start[k]).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
 
 /// A block 1 × 1 × `h` m on a fixed slope of `theta` degrees, 20 m long, with φ = 20° and
 /// `times` the cohesion limit equilibrium needs to hold it.
@@ -61,7 +45,7 @@ fn cohesive_joints_hold_exactly_at_limit_equilibrium() {
                 // DDA-3p, the baseline, is left out: its first step loads the soft penalty
                 // springs at once, the corners overshoot their strength and lose their
                 // cohesion, and the block slides at 1.05 times the cohesion as it did before.
-                let moved = travel(&slope(theta, h, times), Method::Alm, 2.0);
+                let moved = travel(&slope(theta, h, times), Method::Alm, Some(2.0));
                 let case = format!("θ {theta}°, h {h} m, {times} × c");
                 eprintln!("{case}: moved {moved:.3e} m");
                 if stands {

@@ -7,24 +7,9 @@
 //! slope's) a contact needed to open.
 
 use dda3d::params::Method;
-use dda3d::scene;
-use dda3d::solver::Solver;
 
-/// The block's centroid travel after 1.5 s.
-fn travel(text: &str, method: Method) -> f64 {
-    let mut s = scene::parse(text, "topple.toml", "topple").expect("scene parses");
-    s.params.method = method;
-    let mut solver = Solver::new(s.model, s.params);
-    let start = solver.snapshot().blocks[1].centroid;
-    while !solver.finished() {
-        solver.step().expect("runs");
-    }
-    let end = solver.snapshot().blocks[1].centroid;
-    (0..3)
-        .map(|k| (end[k] - start[k]).powi(2))
-        .sum::<f64>()
-        .sqrt()
-}
+mod travel_support;
+use travel_support::travel;
 
 /// A block `b` × `b` × `h` standing on a fixed slope of `theta` degrees, 20 m long, with a
 /// friction angle 20° above the slope's (it cannot slide).
@@ -59,7 +44,7 @@ fn blocks_topple_exactly_when_their_centroid_overhangs_the_base() {
             for (ratio, topples) in [(0.9, true), (1.1, false)] {
                 let b = ratio * limit * h;
                 for method in [Method::Alm, Method::Penalty] {
-                    let moved = travel(&incline(theta, b, h), method);
+                    let moved = travel(&incline(theta, b, h), method, None);
                     let case = format!("{method:?}, θ {theta}°, b/h = {ratio} tan θ, h {h} m");
                     eprintln!("{case}: moved {moved:.3e} m");
                     // DDA-3p's soft penalty springs let a standing block settle by a fraction

@@ -1,0 +1,25 @@
+//! What the slide, toppling and cohesion tests measure: how far a scene's block 1 travels.
+
+use dda3d::params::Method;
+use dda3d::scene;
+use dda3d::solver::Solver;
+
+/// Block 1's centroid travel, m, from the start to the end of `text` run by `method` (for
+/// `duration` s, or the scene's own duration).
+pub fn travel(text: &str, method: Method, duration: Option<f64>) -> f64 {
+    let mut s = scene::parse(text, "block.toml", "block").expect("scene parses");
+    s.params.method = method;
+    if let Some(d) = duration {
+        s.params.duration = d;
+    }
+    let mut solver = Solver::new(s.model, s.params);
+    let start = solver.snapshot().blocks[1].centroid;
+    while !solver.finished() {
+        solver.step().expect("runs");
+    }
+    let end = solver.snapshot().blocks[1].centroid;
+    (0..3)
+        .map(|k| (end[k] - start[k]).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
