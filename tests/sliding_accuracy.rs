@@ -119,18 +119,21 @@ fn pushed_blocks_match_theory_from_the_first_step() {
     assert!(worst.0 < 5e-4, "{:.4} % at {}", 100.0 * worst.0, worst.1);
 }
 
-/// Small, light blocks slide too (a 10 cm block on a 20 m slope). The slip tolerance f0·w0
-/// scales with the contact group (w0 = half the slope's length), while a corner spring's
-/// extension scales with the block's weight: held to f0·w0 alone, blocks up to about 40 kg
-/// never slid, even without friction (their travel was 10⁻⁸ m). A contact pressed by more than
-/// 1 % of the lighter block's weight now slides by Mohr–Coulomb alone. DDA-3a's blocks with
-/// friction start about one step late (k⊥ at the onset; 1–3 % at 1 s, noted in the README).
+/// Small, light blocks slide too (2 to 20 cm blocks on a slope of about 40 m). The slip
+/// tolerance f0·w0 scales with the contact group (w0 = half the slope's length), while a corner
+/// spring's extension scales with the block's weight: held to f0·w0 alone, blocks up to about
+/// 40 kg never slid, even without friction (their travel was 10⁻⁸ m). A contact pressed by more
+/// than 1 % of the lighter block's weight now slides by Mohr–Coulomb alone. Under DDA-3a the
+/// friction of a contact that has just begun to slide is then solved again until its lateral
+/// stiffness k⊥ and (for a block this small) its direction τ follow the slip it makes: before,
+/// 10 cm blocks started a step late (up to 17 % short at 1 s at F = 0.95 on 10°) and 2 cm
+/// blocks at F ≥ 0.8 never slid.
 #[test]
 fn small_light_blocks_slide_as_theory_says() {
     let mut worst = [(0.0f64, String::new()), (0.0f64, String::new())];
-    for (a, h) in [(0.1, 0.05), (0.2, 0.1)] {
-        for theta in [20.0f64, 45.0] {
-            for fos in [0.0, 0.5, 0.9] {
+    for (a, h) in [(0.02, 0.01), (0.1, 0.05), (0.2, 0.1)] {
+        for theta in [10.0f64, 20.0, 45.0] {
+            for fos in [0.0, 0.5, 0.95] {
                 for (m, method) in [Method::Alm, Method::Penalty].into_iter().enumerate() {
                     let t = theta.to_radians();
                     let want = 0.5 * 9.8 * (t.sin() - t.cos() * fos * t.tan());
@@ -139,8 +142,9 @@ fn small_light_blocks_slide_as_theory_says() {
                     let case = format!("{method:?}, θ {theta}°, F {fos}, {a} × {h} m");
                     let bound = match (fos == 0.0, method) {
                         (true, _) => 1e-3,
-                        (false, Method::Alm) => 0.03,
-                        (false, Method::Penalty) => 5e-3,
+                        (false, Method::Alm) => 3e-3,
+                        // The baseline's soft springs: 0.6 % at F = 0.95 on 10° (2 cm).
+                        (false, Method::Penalty) => 1e-2,
                     };
                     assert!(
                         err < bound,

@@ -42,6 +42,16 @@ const MAX_FLIPS_PENALTY: u8 = 2;
 /// (2.8 % now; F = 0.905, the reference's wedge cut with a tension crack).
 const ONSET_TURN: f64 = 3.0;
 
+/// A contact that began to slide in this step and whose friction's lateral stiffness k⊥ fell
+/// by more than this factor in a pass counts as changed in the same way (DDA-3a, outside the
+/// equilibrium stage). k⊥ is the friction over the slip (its Newton tangent), and at the onset
+/// the slip is the locked pass's, next to nothing: k⊥ starts at p_τ, and with τ a few degrees
+/// off the slide, the corners' k⊥ held a small block across the slide for its first step
+/// (10 cm blocks 1–17 % short at 1 s, F 0.5–0.95 on 10–60°; within 0.01 % now). Solved again
+/// with the k⊥ of the slip it made, the block slides; a handful of passes in its first step.
+/// Only where p_τ is far too stiff for the contact ([`softens`]).
+const ONSET_SOFTENING: f64 = 2.0;
+
 /// What the check of one pass reads.
 pub(crate) struct CheckInputs<'a> {
     pub params: &'a SolverParams,
@@ -139,17 +149,19 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
         classify(inp, c, &du)
     };
     let before = c.rec.state;
-    let tau_before = c.rec.tau;
+    let (tau_before, lateral_before) = (c.rec.tau, c.lateral);
     apply(inp, c, verdict, shear);
     if c.rec.state == before {
         // A contact that began to slide in this step and whose friction turned by more than
-        // ONSET_TURN is solved again: see `ONSET_TURN`.
-        let onset = inp.onset_turns && before == ContactState::Slide;
-        let turned = onset
-            && c.start.state != ContactState::Slide
-            && tau_before.dot(&c.rec.tau) < ONSET_TURN.to_radians().cos();
+        // ONSET_TURN, or softened across τ by more than ONSET_SOFTENING, is solved again.
+        let onset = inp.onset_turns
+            && before == ContactState::Slide
+            && c.start.state != ContactState::Slide;
+        let again = onset
+            && (tau_before.dot(&c.rec.tau) < ONSET_TURN.to_radians().cos()
+                || (c.lateral * ONSET_SOFTENING < lateral_before && softens(inp, c)));
         // Not `changed`: at the pass limit a turning contact is not a straggler to settle.
-        return (turned, 0);
+        return (again, 0);
     }
     c.changed = true;
     c.flips += 1;
@@ -176,6 +188,17 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
         c.frozen = true;
     }
     (true, frozen)
+}
+
+/// Whether a contact's k⊥ may be iterated at its onset ([`ONSET_SOFTENING`]): its spring's
+/// elastic range N tan φ / p_τ is below the slip tolerance, so that any slip the law can see is
+/// beyond it and k⊥ = p_τ is far too stiff. A heavily loaded contact's range is wider (10⁻⁴ m on
+/// the shipped jointed slope, against f0·w0 = 5·10⁻⁶ m) and p_τ is of the right order there:
+/// iterated too, the slice of that slope in `tests/joint_sets.rs` let a block of its stable
+/// mass move 17 mm in 1 s (0.13 mm as it is) and a free block fall 9 % short.
+fn softens(inp: &CheckInputs, c: &Active) -> bool {
+    let p_tau = inp.params.contact.shear_penalty(c.rec.penalty);
+    law::fine_range(c.force, p_tau, &c.law(inp.params), 1.0)
 }
 
 /// The contact law's verdict on one contact, and the shear spring's extension N(Δ + Δu_ab) of
