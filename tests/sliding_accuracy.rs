@@ -164,3 +164,37 @@ fn small_light_blocks_slide_as_theory_says() {
         );
     }
 }
+
+/// Blocks just past their friction limit (F = 0.99: a net acceleration 1 % of the driving one)
+/// slide, under DDA-3a, as Coulomb says. Such a block gains speed so slowly that its second step
+/// slips less than f0·w0 (1 m on 10°: 2·10⁻⁶ m against 5·10⁻⁶ m), which the stop rule read as a
+/// stop: the contacts stuck again every step and the block stood (travel 4·10⁻⁵ m of 8.5 mm at
+/// 1 s). A contact that slips at least as far as its blocks' velocities carry it is speeding up,
+/// not stopping (`law::speeds_up`).
+#[test]
+fn blocks_just_past_their_friction_limit_slide() {
+    let mut worst = (0.0f64, String::new());
+    for (a, h) in [(0.1, 0.05), (1.0, 0.5)] {
+        for theta in [10.0f64, 20.0, 30.0] {
+            let fos = 0.99;
+            let t = theta.to_radians();
+            let want = 0.5 * 9.8 * (t.sin() - t.cos() * fos * t.tan());
+            let got = travel(&slope(theta, fos, a, h), Method::Alm, Some(1.0));
+            let err = (got - want).abs() / want;
+            let case = format!("θ {theta}°, {a} × {h} m");
+            // 1 %: the net force is 1 % of the driving one, so this is 10⁻⁴ of the friction.
+            assert!(
+                err < 0.01,
+                "{case}: travelled {got:.6} m, theory {want:.6} m"
+            );
+            if err > worst.0 {
+                worst = (err, case);
+            }
+        }
+    }
+    println!(
+        "F = 0.99: largest error at 1 s {:.3} % ({})",
+        100.0 * worst.0,
+        worst.1
+    );
+}

@@ -13,7 +13,7 @@
 //!   cohesion only while the joint is intact), and, unless it carries load, only when the
 //!   spring's shear displacement exceeds f0·w0 (hysteresis for contacts that carry no load);
 //! - a sliding contact sticks again when its slip reverses, or stops (if it was sliding when the
-//!   step began); otherwise its friction turns toward the slip, by the trial force (Cundall's
+//!   step began, and is not speeding up, [`speeds_up`]); otherwise its friction turns toward the slip, by the trial force (Cundall's
 //!   incremental friction, [`turned`]), for slips beyond f0·w0 or, at a small block's onset,
 //!   any slip ([`fine_onset`]).
 
@@ -83,6 +83,10 @@ pub struct Observation {
     pub lambda: f64,
     /// The contact was already sliding when the step began (not only since an earlier pass).
     pub slid_before: bool,
+    /// The tangential motion the blocks' velocities at the step's start give the contact over
+    /// the step, m, where the step carries velocity and the stop rule reads it (DDA-3a's
+    /// dynamic steps outside the equilibrium stage); `None` elsewhere.
+    pub carried: Option<Vec3>,
 }
 
 /// The law's verdict on one contact.
@@ -145,7 +149,7 @@ pub fn classify(o: &Observation, p: &LawParams) -> Transition {
             // began to slide in an earlier pass of this step is held still in this pass by its
             // neighbours' locked (stuck) contacts: sticking it then made the corners of a pushed
             // block take turns, lock against slide, and the block stood for two steps.
-            let stopped = o.slid_before && o.slip.norm() < p.slip_tolerance;
+            let stopped = o.slid_before && o.slip.norm() < p.slip_tolerance && !speeds_up(o, p);
             if reversed(&o.slip, &o.tau, p.slip_tolerance) || stopped {
                 Transition::Stick
             } else if o.slip.norm() > p.slip_tolerance || fine_onset(o, p) {
@@ -186,6 +190,26 @@ pub fn turned(o: &Observation, p: &LawParams) -> Vec3 {
     } else {
         o.slip.normalize()
     }
+}
+
+/// The share of the slip tolerance its blocks' velocities must carry a sliding contact along τ
+/// over the step for [`speeds_up`] to read it as moving.
+pub const CARRIED_SHARE: f64 = 0.1;
+
+/// A sliding contact that its blocks' velocities at the step's start carry forward along τ by
+/// at least [`CARRIED_SHARE`] of the slip tolerance ([`Observation::carried`]), and that slips
+/// at least that far in the solve, is speeding up, not stopping, however short the slip. A
+/// block just past its friction limit gains speed slowly: 1 m on 10° at F = 0.99 slips
+/// 2·10⁻⁶ m in its second step, under f0·w0 = 5·10⁻⁶ m, and the stop rule alone stuck it again
+/// each step (it stood; Coulomb has it slide 8.5 mm in 1 s). The share keeps the rule off the
+/// micro-motions of blocks at rest: without it, a column standing on a slab shaken by an impact
+/// beside it kept sliding contacts that should stick, and moved 6 times further from its run
+/// without sleeping than before (`tests/sleeping.rs`).
+pub fn speeds_up(o: &Observation, p: &LawParams) -> bool {
+    o.carried.is_some_and(|carried| {
+        let along = carried.dot(&o.tau);
+        along > CARRIED_SHARE * p.slip_tolerance && o.slip.dot(&o.tau) >= along
+    })
 }
 
 /// The share of the slip tolerance f0·w0 below which a loaded contact's elastic range
@@ -280,6 +304,7 @@ mod tests {
             tau: Vec3::x(),
             lambda: 1e4,
             slid_before: true,
+            carried: None,
         }
     }
 
@@ -503,6 +528,28 @@ mod tests {
             "within the tolerance itself"
         );
         assert!(!fine_range(1.0e4, 8e7, &p, 1.0));
+    }
+
+    /// A sliding contact that slips less than the tolerance stops, unless its blocks' velocities
+    /// carry it forward (beyond a tenth of the tolerance) and it slips at least that far (it
+    /// speeds up); without the carried motion (static steps, the stage, DDA-3p) the tolerance
+    /// alone decides.
+    #[test]
+    fn a_slow_contact_that_speeds_up_does_not_stop() {
+        let p = law();
+        let mut o = seen(ContactState::Slide);
+        o.slip = Vec3::x() * 5e-7;
+        assert_eq!(classify(&o, &p), Transition::Stick, "no carried motion");
+        o.carried = Some(Vec3::x() * 0.5 * CARRIED_SHARE * p.slip_tolerance);
+        assert_eq!(classify(&o, &p), Transition::Stick, "carried too little");
+        o.carried = Some(Vec3::x() * 4e-7);
+        assert!(speeds_up(&o, &p));
+        assert_eq!(classify(&o, &p), Transition::Keep, "speeding up");
+        o.carried = Some(Vec3::x() * 6e-7);
+        assert_eq!(classify(&o, &p), Transition::Stick, "slowing down");
+        // Across τ, the carried motion does not count.
+        o.carried = Some(Vec3::new(4e-7, 9e-7, 0.0));
+        assert_eq!(classify(&o, &p), Transition::Keep);
     }
 
     /// Cundall's incremental friction: τ turns to the trial force N tan φ·τ + p_τ·slip. A slip

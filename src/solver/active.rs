@@ -78,6 +78,10 @@ pub(crate) struct Active {
     /// k⊥ of a sliding contact (DDA-3a): the stiffness of its friction's direction across the
     /// slip ([`crate::contact::kinematics::add_friction_tangent`]), N/m; 0 otherwise.
     pub lateral: f64,
+    /// The tangential motion the blocks' velocities at the step's start give the contact over
+    /// the step, m: a sliding contact that slips less than this slows down (see
+    /// [`crate::contact::law::Observation::carried`]).
+    pub carried: Vec3,
     /// The part of the start-of-step kept overlap given back in `kin.d0` by the current
     /// attempt ([`Active::release_overlap`]), m.
     pub released: f64,
@@ -287,7 +291,8 @@ impl Active {
     pub fn predict_lateral(&mut self, p: &SolverParams, blocks: &[Block], dt: f64) {
         let v = self.relative_velocity(blocks);
         let n = self.cand.normal;
-        self.set_lateral(p, (v - n * n.dot(&v)).norm() * dt);
+        self.carried = (v - n * n.dot(&v)) * dt;
+        self.set_lateral(p, self.carried.norm());
     }
 
     /// The common-plane rule on the solution `d` for a V–F contact with alternative faces: the

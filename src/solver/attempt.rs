@@ -10,7 +10,7 @@ use super::open_close::{self, CheckInputs};
 use super::step_control::{self, Retry};
 use crate::contact::groups::ContactGroups;
 use crate::model::Block;
-use crate::params::{Method, SolverParams};
+use crate::params::{Method, Mode, SolverParams};
 use crate::physics::integrator::Scheme;
 use crate::physics::linear::{BlockMatrix, SparseCholesky};
 
@@ -129,6 +129,7 @@ fn open_close_iteration(
             dt: inp.dt,
             pass: solved.oc_passes,
             onset_turns: p.method == Method::Alm && !inp.in_stage,
+            carries: p.method == Method::Alm && !inp.in_stage && p.mode == Mode::Dynamic,
             holding: &Default::default(),
         };
         let changed = open_close::check(&check, &solved.d, active, counters);

@@ -66,6 +66,9 @@ pub(crate) struct CheckInputs<'a> {
     /// The friction of contacts that began to slide in the step is iterated to its direction
     /// ([`ONSET_TURN`]): DDA-3a, outside the equilibrium stage.
     pub onset_turns: bool,
+    /// Steps carry velocity, and a sliding contact that speeds up does not stop
+    /// ([`law::speeds_up`]): DDA-3a's dynamic steps outside the equilibrium stage.
+    pub carries: bool,
     /// Block pairs whose intact cohesive joint holds as a whole ([`holding_joints`]); filled
     /// by [`check`] itself.
     pub holding: &'a BTreeSet<(usize, usize)>,
@@ -231,6 +234,7 @@ fn classify(inp: &CheckInputs, c: &mut Active, du: &Vec3) -> (Transition, Vec3) 
         tau: c.rec.tau,
         lambda: c.rec.lambda,
         slid_before: c.start.state == ContactState::Slide,
+        carried: inp.carries.then_some(c.carried),
     };
     (law::classify(&seen, &c.law(inp.params)), shear)
 }
