@@ -51,6 +51,27 @@ fn run_error(dir: &Path, text: &str, what: &str) -> String {
     err
 }
 
+/// A value of the wrong kind, or a table that lacks a key, is named by its key: an inline
+/// table where a number belongs, and a block without its material (before: "line 2: invalid
+/// type: map, expected f64" and "line 5: missing field `material`", no key).
+#[test]
+fn wrong_values_and_incomplete_tables_are_named() {
+    let dir = tmp("named");
+    let map = scene("").replace("density = 2750.0", "density = { a = 1 }");
+    let err = run_error(&dir, &map, "a map");
+    assert!(
+        err.contains("line 2: materials.rock.density: invalid type: map"),
+        "{err}"
+    );
+    let text =
+        scene("[[blocks]]\nname = \"b\"\nbox = { size = [1, 1, 1], center = [3, 0, 0.5] }\n");
+    let err = run_error(&dir, &text, "no material");
+    assert!(
+        err.contains("line 9: blocks[1]: missing field `material`"),
+        "{err}"
+    );
+}
+
 /// Lists of the wrong length, in every field that takes one.
 #[test]
 fn lists_of_numbers_take_exactly_their_length() {
@@ -260,6 +281,8 @@ fn absurd_overrides_are_rejected_naming_the_flag() {
             &["-1", "0", "1e-15", "1.5", "3e9", "1e308"],
         ),
         ("--spectral-radius", &["-1", "0", "0.3", "1.01", "1e308"]),
+        // A negative number is a value, not a flag ("unexpected argument '-1'" before).
+        ("--output-interval", &["-1", "0", "nan"]),
     ] {
         for value in values {
             let what = format!("{flag} {value}");

@@ -27,7 +27,7 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub overrides: SolverOverrides,
     /// Frames per second of simulated time.
-    #[arg(long, default_value_t = 30.0)]
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub fps: f64,
     #[arg(long, default_value_t = 1280)]
     pub width: u32,
@@ -44,7 +44,7 @@ pub struct RenderArgs {
     #[arg(long, default_value = "block")]
     pub color: String,
     /// Force arrow scale in N per metre of arrow (default: automatic, fixed after frame 0).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub force_scale: Option<f64>,
     /// Draw contact normals as well as the force arrows.
     #[arg(long, conflicts_with = "no_arrows")]

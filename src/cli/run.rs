@@ -61,7 +61,7 @@ pub struct RunArgs {
     /// Simulated time between outputs, s: the CSV rows and the VTK series (the scene's
     /// `[output] interval`; default: every step). The first state, the first step at or past
     /// each multiple, and the final state are written
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
     pub output_interval: Option<f64>,
 }
 

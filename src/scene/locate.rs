@@ -70,13 +70,17 @@ fn find_value(table: &DeTable<'_>, offset: usize, prefix: &str) -> Option<String
     for (name, value) in table.iter() {
         let key = format!("{prefix}{}", name.get_ref());
         let found = match value.get_ref() {
-            DeValue::Table(t) => find_value(t, offset, &format!("{key}.")),
+            // A table's own span (an inline table's text, a header) names it where no value
+            // inside it holds the offset: `density = { a = 1 }`, a block without `material`.
+            DeValue::Table(t) => find_value(t, offset, &format!("{key}."))
+                .or_else(|| value.span().contains(&offset).then(|| key.clone())),
             DeValue::Array(items)
                 if !items.is_empty() && items.iter().all(|i| i.get_ref().is_table()) =>
             {
                 items.iter().enumerate().find_map(|(k, item)| {
                     let t = item.get_ref().as_table()?;
                     find_value(t, offset, &format!("{key}[{k}]."))
+                        .or_else(|| item.span().contains(&offset).then(|| format!("{key}[{k}]")))
                 })
             }
             _ => value.span().contains(&offset).then_some(key),
@@ -113,6 +117,16 @@ mod tests {
         assert_eq!(
             key_at(inline, inline.find('7').unwrap()).as_deref(),
             Some("solver.contact.beta")
+        );
+        let map = "[materials.rock]\ndensity = { a = 1 }\n";
+        assert_eq!(
+            key_at(map, map.find('{').unwrap()).as_deref(),
+            Some("materials.rock.density")
+        );
+        let header = "[[blocks]]\nname = \"a\"\n[[blocks]]\nname = \"b\"\n";
+        assert_eq!(
+            key_at(header, header.rfind("[[").unwrap()).as_deref(),
+            Some("blocks[1]")
         );
         assert_eq!(line_of("a\nb\nc", 4), 3);
         assert_eq!(line_of("a", 99), 1);
