@@ -183,7 +183,7 @@ fn pair_shears(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeMap<(usi
         let force = (r - n * n.dot(&r)) * inp.params.contact.shear_penalty(c.rec.penalty);
         let (i, j) = c.blocks();
         let sign = if i < j { 1.0 } else { -1.0 };
-        *sums.entry((i.min(j), i.max(j))).or_insert_with(Vec3::zeros) += force * sign;
+        *sums.entry(key(c)).or_insert_with(Vec3::zeros) += force * sign;
     }
     sums
 }
