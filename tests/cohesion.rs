@@ -63,3 +63,31 @@ fn cohesive_joints_hold_exactly_at_limit_equilibrium() {
         }
     }
 }
+
+/// A joint's shear is the resultant of its contacts' shear forces. The corners of a 10 cm block
+/// of soft rock (E = 1 GPa) spread under its weight, and their springs pull sideways in
+/// opposite directions as well as down the slope: summed as magnitudes, the joint's shear
+/// passed its strength at 1.05 times the cohesion it needs and the block slid as if it had none.
+#[test]
+fn a_small_block_of_soft_rock_holds_on_its_cohesion() {
+    for theta in [25.0f64, 35.0] {
+        for (times, stands) in [(0.9, false), (1.05, true)] {
+            let text = slope(theta, 0.05, times)
+                .replace("size = [1, 1, 0.05]", "size = [0.1, 0.1, 0.05]")
+                .replace("young_modulus = 2.0e10", "young_modulus = 1.0e9");
+            assert!(text.contains("size = [0.1, 0.1, 0.05]") && text.contains("= 1.0e9"));
+            let moved = travel(&text, Method::Alm, Some(2.0));
+            let case = format!("θ {theta}°, {times} × c");
+            if stands {
+                assert!(moved < 1e-4, "{case}: moved {moved:.2e} m");
+            } else {
+                let t = theta.to_radians();
+                let want = 2.0 * 9.8 * (t.sin() - t.cos() * PHI.to_radians().tan());
+                assert!(
+                    (moved - want).abs() < 0.01 * want,
+                    "{case}: moved {moved:.3} m of {want:.3}"
+                );
+            }
+        }
+    }
+}

@@ -97,7 +97,7 @@ pub(crate) struct CheckInputs<'a> {
 /// φ = 20° slid at 1.43 times the cohesion limit equilibrium needs. The joint is judged whole,
 /// as limit equilibrium does; once it fails, its contacts are judged one by one again.
 fn holding_joints(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeSet<(usize, usize)> {
-    let mut sums: BTreeMap<(usize, usize), (f64, f64)> = BTreeMap::new();
+    let mut sums: BTreeMap<(usize, usize), (Vec3, f64)> = BTreeMap::new();
     for c in active {
         let cohesion = c.cohesion(inp.params);
         if c.frozen || c.rec.state != ContactState::Lock || cohesion <= 0.0 {
@@ -105,15 +105,23 @@ fn holding_joints(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeSet<(
         }
         let n = c.cand.normal;
         let r = (c.cand.xa - c.rec.reference) + c.relative_displacement(d, inp.blocks);
-        let shear = (r - n * n.dot(&r)).norm() * inp.params.contact.shear_penalty(c.rec.penalty);
+        let shear = (r - n * n.dot(&r)) * inp.params.contact.shear_penalty(c.rec.penalty);
         let strength = c.force.max(0.0) * c.tan_phi(inp.params) + cohesion;
-        let sum = sums.entry(c.blocks()).or_default();
-        *sum = (sum.0 + shear, sum.1 + strength);
+        let (i, j) = c.blocks();
+        let sign = if i < j { 1.0 } else { -1.0 };
+        let sum = sums.entry(pair_key(c)).or_insert((Vec3::zeros(), 0.0));
+        *sum = (sum.0 + shear * sign, sum.1 + strength);
     }
     sums.into_iter()
-        .filter(|(_, (shear, strength))| shear <= strength)
+        .filter(|(_, (shear, strength))| shear.norm() <= *strength)
         .map(|(pair, _)| pair)
         .collect()
+}
+
+/// A contact's block pair, the lower-numbered block first.
+fn pair_key(c: &Active) -> (usize, usize) {
+    let (i, j) = c.blocks();
+    (i.min(j), i.max(j))
 }
 
 /// Classifies every contact from the solution `d` and applies the verdicts. Returns whether a
@@ -159,23 +167,19 @@ pub(crate) fn check(
 /// locked contacts, as a force on the pair's lower-numbered block ([`ONSET_RESULTANT`]).
 fn pair_shears(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeMap<(usize, usize), Vec3> {
     let locked = |c: &&Active| !c.frozen && c.rec.state == ContactState::Lock;
-    let key = |c: &Active| {
-        let (i, j) = c.blocks();
-        (i.min(j), i.max(j))
-    };
     // Only the pairs with a contact the rule may apply to: none in most rock masses.
     let wanted: BTreeSet<(usize, usize)> = active
         .iter()
         .filter(locked)
         .filter(|c| softens(inp, c))
-        .map(key)
+        .map(pair_key)
         .collect();
     let mut sums: BTreeMap<(usize, usize), Vec3> = BTreeMap::new();
     if wanted.is_empty() {
         return sums;
     }
     for c in active.iter().filter(locked) {
-        if !wanted.contains(&key(c)) {
+        if !wanted.contains(&pair_key(c)) {
             continue;
         }
         let n = c.cand.normal;
@@ -183,7 +187,7 @@ fn pair_shears(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeMap<(usi
         let force = (r - n * n.dot(&r)) * inp.params.contact.shear_penalty(c.rec.penalty);
         let (i, j) = c.blocks();
         let sign = if i < j { 1.0 } else { -1.0 };
-        *sums.entry(key(c)).or_insert_with(Vec3::zeros) += force * sign;
+        *sums.entry(pair_key(c)).or_insert_with(Vec3::zeros) += force * sign;
     }
     sums
 }
@@ -193,7 +197,7 @@ fn pair_shears(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeMap<(usi
 /// that lies within [`ONSET_RESULTANT`] of `own`.
 fn onset_direction(inp: &CheckInputs, c: &Active, own: Vec3) -> Vec3 {
     let (i, j) = c.blocks();
-    let Some(r) = inp.pair_shear.get(&(i.min(j), i.max(j))) else {
+    let Some(r) = inp.pair_shear.get(&pair_key(c)) else {
         return own;
     };
     let r = if i < j { *r } else { -*r };
@@ -298,7 +302,7 @@ fn classify(inp: &CheckInputs, c: &mut Active, du: &Vec3) -> (Transition, Vec3) 
         normal_force: c.force,
         shear,
         shear_stiffness: cp.shear_penalty(c.rec.penalty),
-        cohesion: if c.rec.intact && inp.holding.contains(&c.blocks()) {
+        cohesion: if c.rec.intact && inp.holding.contains(&pair_key(c)) {
             f64::INFINITY
         } else {
             c.cohesion(inp.params)
