@@ -13,9 +13,9 @@
 //!   cohesion only while the joint is intact), and, unless it carries load, only when the
 //!   spring's shear displacement exceeds f0·w0 (hysteresis for contacts that carry no load);
 //! - a sliding contact sticks again when its slip reverses, or stops (if it was sliding when the
-//!   step began, and is not speeding up, [`speeds_up`]); otherwise its friction turns toward the slip, by the trial force (Cundall's
-//!   incremental friction, [`turned`]), for slips beyond f0·w0 or, at a small block's onset,
-//!   any slip ([`fine_onset`]).
+//!   step began, and is not speeding up, [`speeds_up`]); otherwise its friction turns toward
+//!   the slip, by the trial force (Cundall's incremental friction, [`turned`]), for slips beyond
+//!   f0·w0 or, at a small block's onset, any slip ([`fine_onset`]).
 
 use super::ContactState;
 use crate::physics::geometry::Vec3;

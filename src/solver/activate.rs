@@ -220,7 +220,6 @@ fn activate_one(
         slip: Vec3::zeros(),
         du: Vec3::zeros(),
         lateral: 0.0,
-        carried: Vec3::zeros(),
         released: 0.0,
     };
     (active, old.is_none())

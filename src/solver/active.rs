@@ -78,10 +78,6 @@ pub(crate) struct Active {
     /// k⊥ of a sliding contact (DDA-3a): the stiffness of its friction's direction across the
     /// slip ([`crate::contact::kinematics::add_friction_tangent`]), N/m; 0 otherwise.
     pub lateral: f64,
-    /// The tangential motion the blocks' velocities at the step's start give the contact over
-    /// the step, m: a sliding contact that slips less than this slows down (see
-    /// [`crate::contact::law::Observation::carried`]).
-    pub carried: Vec3,
     /// The part of the start-of-step kept overlap given back in `kin.d0` by the current
     /// attempt ([`Active::release_overlap`]), m.
     pub released: f64,
@@ -289,10 +285,23 @@ impl Active {
     /// k⊥ at the start of an attempt of length `dt`: the slip expected over the step is what
     /// the blocks' relative tangential velocity gives.
     pub fn predict_lateral(&mut self, p: &SolverParams, blocks: &[Block], dt: f64) {
+        self.set_lateral(p, self.carried(blocks, dt).norm());
+    }
+
+    /// The tangential motion the blocks' velocities at the step's start give the contact over
+    /// `dt`, m ([`crate::contact::law::Observation::carried`]).
+    pub fn carried(&self, blocks: &[Block], dt: f64) -> Vec3 {
         let v = self.relative_velocity(blocks);
         let n = self.cand.normal;
-        self.carried = (v - n * n.dot(&v)) * dt;
-        self.set_lateral(p, self.carried.norm());
+        (v - n * n.dot(&v)) * dt
+    }
+
+    /// The locked shear spring's extension N(Δ + Δu_ab) for the relative displacement `du` of a
+    /// solve, m: tangential.
+    pub fn spring_extension(&self, du: &Vec3) -> Vec3 {
+        let n = self.cand.normal;
+        let r = (self.cand.xa - self.rec.reference) + du;
+        r - n * n.dot(&r)
     }
 
     /// The common-plane rule on the solution `d` for a V–F contact with alternative faces: the

@@ -103,14 +103,9 @@ fn holding_joints(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeSet<(
         if c.frozen || c.rec.state != ContactState::Lock || cohesion <= 0.0 {
             continue;
         }
-        let n = c.cand.normal;
-        let r = (c.cand.xa - c.rec.reference) + c.relative_displacement(d, inp.blocks);
-        let shear = (r - n * n.dot(&r)) * inp.params.contact.shear_penalty(c.rec.penalty);
         let strength = c.force.max(0.0) * c.tan_phi(inp.params) + cohesion;
-        let (i, j) = c.blocks();
-        let sign = if i < j { 1.0 } else { -1.0 };
         let sum = sums.entry(pair_key(c)).or_insert((Vec3::zeros(), 0.0));
-        *sum = (sum.0 + shear * sign, sum.1 + strength);
+        *sum = (sum.0 + spring_force_on_lower(inp, d, c), sum.1 + strength);
     }
     sums.into_iter()
         .filter(|(_, (shear, strength))| shear.norm() <= *strength)
@@ -122,6 +117,20 @@ fn holding_joints(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeSet<(
 fn pair_key(c: &Active) -> (usize, usize) {
     let (i, j) = c.blocks();
     (i.min(j), i.max(j))
+}
+
+/// 1 where the contact's block i is its pair's lower-numbered block, −1 otherwise: the sign
+/// that turns the contact's tangential quantities (of i against j) into the pair's.
+fn lower_sign(c: &Active) -> f64 {
+    let (i, j) = c.blocks();
+    if i < j { 1.0 } else { -1.0 }
+}
+
+/// A locked contact's shear spring force p_τ·N(Δ + Δu_ab) in the solution `d`, on its pair's
+/// lower-numbered block, N.
+fn spring_force_on_lower(inp: &CheckInputs, d: &[f64], c: &Active) -> Vec3 {
+    let extension = c.spring_extension(&c.relative_displacement(d, inp.blocks));
+    extension * (inp.params.contact.shear_penalty(c.rec.penalty) * lower_sign(c))
 }
 
 /// Classifies every contact from the solution `d` and applies the verdicts. Returns whether a
@@ -182,12 +191,7 @@ fn pair_shears(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeMap<(usi
         if !wanted.contains(&pair_key(c)) {
             continue;
         }
-        let n = c.cand.normal;
-        let r = (c.cand.xa - c.rec.reference) + c.relative_displacement(d, inp.blocks);
-        let force = (r - n * n.dot(&r)) * inp.params.contact.shear_penalty(c.rec.penalty);
-        let (i, j) = c.blocks();
-        let sign = if i < j { 1.0 } else { -1.0 };
-        *sums.entry(pair_key(c)).or_insert_with(Vec3::zeros) += force * sign;
+        *sums.entry(pair_key(c)).or_insert_with(Vec3::zeros) += spring_force_on_lower(inp, d, c);
     }
     sums
 }
@@ -196,11 +200,10 @@ fn pair_shears(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeMap<(usi
 /// extension): the direction of its block pair's resultant shear in its tangent plane, where
 /// that lies within [`ONSET_RESULTANT`] of `own`.
 fn onset_direction(inp: &CheckInputs, c: &Active, own: Vec3) -> Vec3 {
-    let (i, j) = c.blocks();
     let Some(r) = inp.pair_shear.get(&pair_key(c)) else {
         return own;
     };
-    let r = if i < j { *r } else { -*r };
+    let r = r * lower_sign(c);
     let n = c.cand.normal;
     let t = r - n * n.dot(&r);
     if t.norm() > 0.0 && t.normalize().dot(&own) > ONSET_RESULTANT.to_radians().cos() {
@@ -290,9 +293,7 @@ fn classify(inp: &CheckInputs, c: &mut Active, du: &Vec3) -> (Transition, Vec3) 
         c.rec.normal_force = c.force;
     }
     let shear = if c.rec.state == ContactState::Lock {
-        let n = c.cand.normal;
-        let r = (c.cand.xa - c.rec.reference) + du;
-        r - n * n.dot(&r)
+        c.spring_extension(du)
     } else {
         Vec3::zeros()
     };
@@ -311,7 +312,8 @@ fn classify(inp: &CheckInputs, c: &mut Active, du: &Vec3) -> (Transition, Vec3) 
         tau: c.rec.tau,
         lambda: c.rec.lambda,
         slid_before: c.start.state == ContactState::Slide,
-        carried: inp.carries.then_some(c.carried),
+        carried: (inp.carries && c.rec.state == ContactState::Slide)
+            .then(|| c.carried(inp.blocks, inp.dt)),
     };
     (law::classify(&seen, &c.law(inp.params)), shear)
 }
