@@ -9,7 +9,7 @@
 use dda3d::params::Method;
 
 mod travel_support;
-use travel_support::travel;
+use travel_support::{on_slope, travel};
 
 const PHI: f64 = 20.0;
 
@@ -19,12 +19,7 @@ fn slope(theta: f64, h: f64, times: f64) -> String {
     let t = theta.to_radians();
     let weight = h * 2700.0 * 9.8;
     let cohesion = times * weight * (t.sin() - t.cos() * PHI.to_radians().tan());
-    let n = [t.sin(), 0.0, t.cos()];
-    let down = [t.cos(), 0.0, -t.sin()];
-    let c = |s: f64, along: f64| {
-        let p: Vec<f64> = (0..3).map(|k| n[k] * s + down[k] * along).collect();
-        format!("[{}, {}, {}]", p[0], p[1], p[2])
-    };
+    let c = |s: f64, along: f64| on_slope(theta, s, along);
     format!(
         "[joint]\nfriction_angle = {PHI}\ncohesion = {cohesion}\n\
          [materials.rock]\ndensity = 2700.0\nyoung_modulus = 2.0e10\npoisson_ratio = 0.25\n\
@@ -35,6 +30,13 @@ fn slope(theta: f64, h: f64, times: f64) -> String {
         c(-1.0, 0.0),
         c(h / 2.0, -5.0)
     )
+}
+
+/// How far a block slides in 2 s on `theta` degrees without its cohesion, m:
+/// ½ g (sin θ − cos θ tan φ) t².
+fn frictional_travel(theta: f64) -> f64 {
+    let t = theta.to_radians();
+    2.0 * 9.8 * (t.sin() - t.cos() * PHI.to_radians().tan())
 }
 
 #[test]
@@ -51,9 +53,7 @@ fn cohesive_joints_hold_exactly_at_limit_equilibrium() {
                 if stands {
                     assert!(moved < 1e-5, "{case}: moved {moved:.2e} m");
                 } else {
-                    // Sliding without its cohesion: ½ g (sin θ − cos θ tan φ) t², t = 2 s.
-                    let t = theta.to_radians();
-                    let want = 2.0 * 9.8 * (t.sin() - t.cos() * PHI.to_radians().tan());
+                    let want = frictional_travel(theta);
                     assert!(
                         moved > 0.9 * want,
                         "{case}: moved {moved:.3} m of {want:.3}"
@@ -81,8 +81,7 @@ fn a_small_block_of_soft_rock_holds_on_its_cohesion() {
             if stands {
                 assert!(moved < 1e-4, "{case}: moved {moved:.2e} m");
             } else {
-                let t = theta.to_radians();
-                let want = 2.0 * 9.8 * (t.sin() - t.cos() * PHI.to_radians().tan());
+                let want = frictional_travel(theta);
                 assert!(
                     (moved - want).abs() < 0.01 * want,
                     "{case}: moved {moved:.3} m of {want:.3}"

@@ -8,7 +8,7 @@
 use dda3d::params::Method;
 
 mod travel_support;
-use travel_support::travel;
+use travel_support::{on_slope, travel};
 
 const ROCK: &str =
     "[materials.rock]\ndensity = 2750.0\nyoung_modulus = 2.0e10\npoisson_ratio = 0.25\n";
@@ -22,15 +22,9 @@ fn slope(theta: f64, fos: f64, a: f64, h: f64) -> String {
 /// [`slope`] on a slope `length` m long.
 fn slope_of_length(theta: f64, fos: f64, a: f64, h: f64, length: f64) -> String {
     let phi = (fos * theta.to_radians().tan()).atan().to_degrees();
-    let t = theta.to_radians();
-    let n = [t.sin(), 0.0, t.cos()];
     let depth = a.max(h);
-    let down = [t.cos(), 0.0, -t.sin()];
     let shift = length / 2.0 - 2.0 * a;
-    let c = |s: f64, along: f64| {
-        let p: Vec<f64> = (0..3).map(|k| n[k] * s + down[k] * along).collect();
-        format!("[{}, {}, {}]", p[0], p[1], p[2])
-    };
+    let c = |s: f64, along: f64| on_slope(theta, s, along);
     format!(
         "[joint]\nfriction_angle = {phi}\n{ROCK}\
          [[blocks]]\nname = \"slope\"\nmaterial = \"rock\"\nfixed = true\n\
@@ -41,6 +35,13 @@ fn slope_of_length(theta: f64, fos: f64, a: f64, h: f64, length: f64) -> String 
         c(-depth / 2.0, shift),
         c(h / 2.0, 0.0)
     )
+}
+
+/// Coulomb's travel from rest on a slope of `theta` degrees at a factor of safety `fos`
+/// (tan φ = `fos` tan θ) after `time` s, m: ½ g (sin θ − cos θ tan φ) t².
+fn coulomb_travel(theta: f64, fos: f64, time: f64) -> f64 {
+    let t = theta.to_radians();
+    0.5 * 9.8 * (t.sin() - t.cos() * fos * t.tan()) * time * time
 }
 
 /// A block `a` × `a` × `h` on a flat fixed base with friction angle `phi`, pushed along x at its
@@ -68,9 +69,7 @@ fn slides_near_the_friction_limit_match_theory_from_the_first_step() {
     for theta in [20.0f64, 30.0, 40.0] {
         for fos in [0.5, 0.8, 0.9, 0.95] {
             for (a, h) in [(2.0, 1.0), (4.0, 1.0), (1.0, 0.5)] {
-                let t = theta.to_radians();
-                let acc = 9.8 * (t.sin() - t.cos() * fos * t.tan());
-                let want = 0.5 * acc * 4.0;
+                let want = coulomb_travel(theta, fos, 2.0);
                 let got = travel(&slope(theta, fos, a, h), Method::Alm, Some(2.0));
                 let err = (got - want).abs() / want;
                 let case = format!("θ {theta}°, F {fos}, {a} × {h} m");
@@ -139,8 +138,7 @@ fn small_light_blocks_slide_as_theory_says() {
         for theta in [10.0f64, 20.0, 45.0] {
             for fos in [0.0, 0.5, 0.95] {
                 for (m, method) in [Method::Alm, Method::Penalty].into_iter().enumerate() {
-                    let t = theta.to_radians();
-                    let want = 0.5 * 9.8 * (t.sin() - t.cos() * fos * t.tan());
+                    let want = coulomb_travel(theta, fos, 1.0);
                     let got = travel(&slope(theta, fos, a, h), method, Some(1.0));
                     let err = (got - want).abs() / want;
                     let case = format!("{method:?}, θ {theta}°, F {fos}, {a} × {h} m");
@@ -181,8 +179,7 @@ fn blocks_just_past_their_friction_limit_slide() {
     for (a, h) in [(0.1, 0.05), (1.0, 0.5)] {
         for theta in [10.0f64, 20.0, 30.0] {
             let fos = 0.99;
-            let t = theta.to_radians();
-            let want = 0.5 * 9.8 * (t.sin() - t.cos() * fos * t.tan());
+            let want = coulomb_travel(theta, fos, 1.0);
             let got = travel(&slope(theta, fos, a, h), Method::Alm, Some(1.0));
             let err = (got - want).abs() / want;
             let case = format!("θ {theta}°, {a} × {h} m");
@@ -218,8 +215,7 @@ fn small_blocks_of_soft_rock_slide_from_their_first_step() {
             let text = slope_of_length(theta, fos, 0.1, 0.05, 10.0)
                 .replace("young_modulus = 2.0e10", "young_modulus = 1.0e9");
             assert!(text.contains("young_modulus = 1.0e9"));
-            let t = theta.to_radians();
-            let want = 0.5 * 9.8 * (t.sin() - t.cos() * fos * t.tan());
+            let want = coulomb_travel(theta, fos, 1.0);
             let got = travel(&text, Method::Alm, Some(1.0));
             let err = (got - want).abs() / want;
             let case = format!("θ {theta}°, F {fos}");

@@ -9,18 +9,12 @@
 use dda3d::params::Method;
 
 mod travel_support;
-use travel_support::travel;
+use travel_support::{on_slope, travel};
 
 /// A block `b` × `b` × `h` standing on a fixed slope of `theta` degrees, 20 m long, with a
 /// friction angle 20° above the slope's (it cannot slide).
 fn incline(theta: f64, b: f64, h: f64) -> String {
-    let t = theta.to_radians();
-    let n = [t.sin(), 0.0, t.cos()];
-    let down = [t.cos(), 0.0, -t.sin()];
-    let c = |s: f64, along: f64| {
-        let p: Vec<f64> = (0..3).map(|k| n[k] * s + down[k] * along).collect();
-        format!("[{}, {}, {}]", p[0], p[1], p[2])
-    };
+    let c = |s: f64, along: f64| on_slope(theta, s, along);
     format!(
         "[solver]\nduration = 1.5\nmax_time_step = 0.005\n\
          [joint]\nfriction_angle = {}\n\

@@ -1,4 +1,5 @@
-//! What the slide, toppling and cohesion tests measure: how far a scene's block 1 travels.
+//! What the slide, toppling and cohesion tests measure: how far a scene's block 1 travels; and
+//! where their blocks sit on a slope.
 
 use dda3d::params::Method;
 use dda3d::scene;
@@ -22,4 +23,14 @@ pub fn travel(text: &str, method: Method, duration: Option<f64>) -> f64 {
         .map(|k| (end[k] - start[k]).powi(2))
         .sum::<f64>()
         .sqrt()
+}
+
+/// The point `s` m off a slope of `theta` degrees (along its outward normal, in the x–z plane,
+/// dipping toward +x) and `along` m down its dip from the origin, as a scene's `[x, y, z]`.
+pub fn on_slope(theta: f64, s: f64, along: f64) -> String {
+    let t = theta.to_radians();
+    let n = [t.sin(), 0.0, t.cos()];
+    let down = [t.cos(), 0.0, -t.sin()];
+    let p: Vec<f64> = (0..3).map(|k| n[k] * s + down[k] * along).collect();
+    format!("[{}, {}, {}]", p[0], p[1], p[2])
 }
