@@ -215,6 +215,7 @@ fn activate_one(
         friction_cap: None,
         flips: 0,
         frozen: false,
+        stopped: false,
         changed: false,
         shear: Vec3::zeros(),
         slip: Vec3::zeros(),

@@ -65,6 +65,8 @@ pub(crate) struct Active {
     pub flips: u8,
     /// Settled after cycling: no more state changes in this attempt.
     pub frozen: bool,
+    /// Stopped by the contact law in this attempt ([`law::Observation::restarted`]).
+    pub stopped: bool,
     /// Changed state in the last open–close pass.
     pub changed: bool,
     /// N(Δ + Δu_ab) of a locked contact after the last solve.

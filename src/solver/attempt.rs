@@ -81,6 +81,7 @@ fn open_close_iteration(
     for c in active.iter_mut() {
         c.flips = 0;
         c.frozen = false;
+        c.stopped = false;
         c.release_overlap(inp.dt);
         c.predict_lateral(p, inp.blocks, inp.dt);
     }

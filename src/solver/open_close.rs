@@ -233,6 +233,7 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
     };
     let before = c.rec.state;
     let (tau_before, lateral_before) = (c.rec.tau, c.lateral);
+    let along = c.slip.dot(&tau_before);
     apply(inp, c, verdict, shear);
     if c.rec.state == before {
         // A contact that began to slide in this step and whose friction turned by more than
@@ -249,7 +250,7 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
     c.changed = true;
     c.flips += 1;
     if debug_log() {
-        log_change(inp, c, before);
+        log_change(inp, c, before, along);
     }
     let mut frozen = 0;
     let max_flips = match inp.params.method {
@@ -312,6 +313,7 @@ fn classify(inp: &CheckInputs, c: &mut Active, du: &Vec3) -> (Transition, Vec3) 
         tau: c.rec.tau,
         lambda: c.rec.lambda,
         slid_before: c.start.state == ContactState::Slide,
+        restarted: c.stopped && inp.params.method == Method::Alm,
         carried: (inp.carries && c.rec.state == ContactState::Slide)
             .then(|| c.carried(inp.blocks, inp.dt)),
     };
@@ -347,6 +349,10 @@ fn apply(inp: &CheckInputs, c: &mut Active, verdict: Transition, shear: Vec3) {
         }
         // The contact carries on with the friction it had (see [`Active::stick`]).
         Transition::Stick => c.stick(inp.params),
+        Transition::Stop => {
+            c.stick(inp.params);
+            c.stopped = true;
+        }
         Transition::Turn { tau } => c.rec.tau = tau,
     }
     // k⊥ follows the slip this solve gave (a contact that has just begun to slide from
@@ -398,10 +404,10 @@ fn close(inp: &CheckInputs, c: &mut Active) {
 /// the solve, its changes so far in the attempt (`flips`, this one included), its state when the
 /// step began, and its features, which with its pair and mode name the contact
 /// (`scripts/open-close-tail.py` reads them).
-fn log_change(inp: &CheckInputs, c: &Active, before: ContactState) {
+fn log_change(inp: &CheckInputs, c: &Active, before: ContactState, along: f64) {
     let k = &c.cand.key;
     eprintln!(
-        "t={:.4} dt={:.2e} pass {}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} pair={}-{} flips={} started={:?} features={}-{}",
+        "t={:.4} dt={:.2e} pass {}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} along={:.2e} tol={:.1e} pair={}-{} flips={} started={:?} features={}-{}",
         inp.time,
         inp.dt,
         inp.pass,
@@ -413,6 +419,8 @@ fn log_change(inp: &CheckInputs, c: &Active, before: ContactState) {
         c.rec.penalty,
         c.shear.norm(),
         c.slip.norm(),
+        along,
+        c.slip_tolerance(inp.params),
         k.i,
         k.j,
         c.flips,
