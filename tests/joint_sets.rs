@@ -529,6 +529,7 @@ fn cross_cut_stacks_with_friction_above_their_dip_stand() {
 /// deep, crossed edges near their ends as 5 cm deep) and
 /// the stick update's shear was capped, this slice diverged at 0.8 s, its upper face blocks
 /// thrown out at 50 m/s; with only the first of those, a block fell through the rock under it.
+/// Few contacts are settled (the open–close iteration converges by the contact law).
 #[test]
 fn a_slice_of_the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/jointed_slope.toml");
@@ -583,4 +584,10 @@ fn a_slice_of_the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
         (0.9..1.0).contains(&median),
         "half the free blocks moved {median} m or less"
     );
+    // The open–close iteration converges by the contact law, not by settling: a settled
+    // contact's state is the solver's guess. While a sliding contact at its friction limit
+    // could stop, slide and stop again within a step, 1457 contacts were settled in this
+    // second (2 since it stops once an attempt).
+    let settled = solver.totals.frozen_contacts;
+    assert!(settled <= 50, "{settled} contacts settled");
 }
