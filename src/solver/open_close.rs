@@ -233,7 +233,6 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
     };
     let before = c.rec.state;
     let (tau_before, lateral_before) = (c.rec.tau, c.lateral);
-    let along = c.slip.dot(&tau_before);
     apply(inp, c, verdict, shear);
     if c.rec.state == before {
         // A contact that began to slide in this step and whose friction turned by more than
@@ -250,7 +249,7 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
     c.changed = true;
     c.flips += 1;
     if debug_log() {
-        log_change(inp, c, before, along);
+        log_change(inp, c, before, &tau_before);
     }
     let mut frozen = 0;
     let max_flips = match inp.params.method {
@@ -401,10 +400,11 @@ fn close(inp: &CheckInputs, c: &mut Active) {
 }
 
 /// `DDA3D_DEBUG=1`: one line per state change: the pass, the change, the contact's values from
-/// the solve, its changes so far in the attempt (`flips`, this one included), its state when the
-/// step began, and its features, which with its pair and mode name the contact
+/// the solve (its slip also along the τ it had before the change, against the slip tolerance),
+/// its changes so far in the attempt (`flips`, this one included), its state when the step
+/// began, and its features, which with its pair and mode name the contact
 /// (`scripts/open-close-tail.py` reads them).
-fn log_change(inp: &CheckInputs, c: &Active, before: ContactState, along: f64) {
+fn log_change(inp: &CheckInputs, c: &Active, before: ContactState, tau_before: &Vec3) {
     let k = &c.cand.key;
     eprintln!(
         "t={:.4} dt={:.2e} pass {}: {:?}->{:?} mode={} N={:.2e} dn={:.2e} p={:.0e} shear={:.2e} slip={:.2e} along={:.2e} tol={:.1e} pair={}-{} flips={} started={:?} features={}-{}",
@@ -419,7 +419,7 @@ fn log_change(inp: &CheckInputs, c: &Active, before: ContactState, along: f64) {
         c.rec.penalty,
         c.shear.norm(),
         c.slip.norm(),
-        along,
+        c.slip.dot(tau_before),
         c.slip_tolerance(inp.params),
         k.i,
         k.j,
