@@ -11,6 +11,8 @@ use super::scene::{FieldLegend, RenderScene};
 
 const TEXT: Color32 = Color32::from_rgb(0x20, 0x20, 0x20);
 const TEXT_DIM: Color32 = Color32::from_rgb(0x44, 0x44, 0x44);
+/// The equilibrium stage's line (the viewer's toolbar shows the stage in the same amber).
+const STAGE_AMBER: Color32 = Color32::from_rgb(0xB0, 0x70, 0x10);
 /// Axis colours of the triad: x red, y green, z blue, the CAD convention.
 const AXIS_COLORS: [Color32; 3] = [
     Color32::from_rgb(0xC0, 0x39, 0x2B),
@@ -99,7 +101,8 @@ pub fn paint_overlay(painter: &egui::Painter, scene: &RenderScene, camera: &Came
     paint_axis_triad(painter, camera, rect);
 }
 
-/// Scene name over simulated time and step, on a card at `top_left`.
+/// Scene name over simulated time and step (and the equilibrium stage's progress while it
+/// runs), on a card at `top_left`.
 fn paint_caption(painter: &egui::Painter, scene: &RenderScene, top_left: Pos2) {
     let title = painter.layout_no_wrap(
         if scene.caption.scene_name.is_empty() {
@@ -119,17 +122,38 @@ fn paint_caption(painter: &egui::Painter, scene: &RenderScene, top_left: Pos2) {
         FontId::proportional(16.0),
         TEXT_DIM,
     );
+    let stage = scene.caption.stage.map(|(steps, residual)| {
+        painter.layout_no_wrap(
+            format!(
+                "equilibrium stage: step {steps}, R_max {}",
+                if (0.01..1000.0).contains(&residual) {
+                    format!("{residual:.3}")
+                } else {
+                    format!("{residual:.2e}")
+                }
+            ),
+            FontId::proportional(16.0),
+            STAGE_AMBER,
+        )
+    });
     let sub_pos = top_left + Vec2::new(0.0, title.size().y + 3.0);
+    let stage_pos = sub_pos + Vec2::new(0.0, sub.size().y + 3.0);
+    let (stage_w, stage_h) = stage
+        .as_ref()
+        .map_or((0.0, 0.0), |g| (g.size().x, g.size().y + 3.0));
     let caption_rect = Rect::from_min_size(
         top_left,
         Vec2::new(
-            title.size().x.max(sub.size().x),
-            title.size().y + 3.0 + sub.size().y,
+            title.size().x.max(sub.size().x).max(stage_w),
+            title.size().y + 3.0 + sub.size().y + stage_h,
         ),
     );
     card(painter, caption_rect, scene.transparent);
     painter.galley(top_left, title, TEXT);
     painter.galley(sub_pos, sub, TEXT_DIM);
+    if let Some(g) = stage {
+        painter.galley(stage_pos, g, STAGE_AMBER);
+    }
 }
 
 /// The legend column at the left edge. Each legend is drawn with its bottom at `y` and returns

@@ -166,6 +166,10 @@ pub struct Caption {
     pub scene_name: String,
     pub time: f64,
     pub step: u64,
+    /// While the initial equilibrium stage runs (time stands at 0): its static steps so far and
+    /// R_max after the last one. A stage of a large rock mass takes minutes, and the picture
+    /// barely moves meanwhile.
+    pub stage: Option<(u64, f64)>,
 }
 
 /// Colour-map legend.
@@ -234,6 +238,10 @@ impl RenderScene {
                 scene_name: snap.scene_name.clone(),
                 time: snap.time,
                 step: snap.step,
+                stage: snap
+                    .equilibrium
+                    .filter(|r| r.running)
+                    .map(|r| (r.steps, r.residual)),
             },
             force_scale: contacts.force_scale,
             field,

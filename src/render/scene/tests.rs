@@ -229,6 +229,31 @@ fn arrow_limit_keeps_the_strongest_contacts() {
     assert_eq!(arrows(Some(100)).arrows_shown, None);
 }
 
+#[test]
+fn the_caption_carries_the_equilibrium_stage_only_while_it_runs() {
+    let mut s = snap(vec![]);
+    let caption = |s: &Snapshot| {
+        RenderScene::build(s, &SceneStyle::default(), &SceneFrame::of_snapshot(s))
+            .unwrap()
+            .caption
+    };
+    assert_eq!(caption(&s).stage, None);
+    let report = EquilibriumReport {
+        steps: 37,
+        residual: 1.245,
+        tolerance: 1e-3,
+        converged: false,
+        running: true,
+    };
+    s.equilibrium = Some(report);
+    assert_eq!(caption(&s).stage, Some((37, 1.245)));
+    s.equilibrium = Some(EquilibriumReport {
+        running: false,
+        ..report
+    });
+    assert_eq!(caption(&s).stage, None);
+}
+
 /// The scene's arrows as the GPU draws them.
 fn triangles(scene: &RenderScene) -> Vec<crate::render::mesh::SolidVertex> {
     scene.arrows.iter().flat_map(|a| a.triangles()).collect()

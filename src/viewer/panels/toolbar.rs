@@ -1,7 +1,10 @@
 //! The toolbar: play/step/reset, simulation speed, simulated time and run state, frame rate,
 //! and the record and screenshot buttons.
 
-use egui::{Align, Color32, Layout, RichText};
+use std::cell::RefCell;
+
+use egui::containers::Sides;
+use egui::{Color32, RichText};
 
 use super::widgets::{ERROR_RED, Icon, OK_GREEN, icon_button, num, seconds};
 use crate::params::table;
@@ -27,21 +30,31 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
         ui.label("starting...");
         return;
     };
-    ui.horizontal(|ui| {
-        ui.spacing_mut().item_spacing.x = 6.0;
-        run_buttons(ui, &frame, actions);
-        ui.separator();
-        speed_box(ui, state, actions);
-        ui.separator();
-        progress(ui, &frame);
-        ui.with_layout(Layout::right_to_left(Align::Center), |ui| {
+    ui.spacing_mut().item_spacing.x = 6.0;
+    // The buttons on the right are laid out first and the run's progress gets what is left,
+    // truncated: in a narrow window (or with the equilibrium stage's long label) it was drawn
+    // under the Save/Load state buttons.
+    // Sides runs one closure, then the other; both need the state and the actions.
+    let shared = RefCell::new((state, actions));
+    Sides::new().shrink_left().truncate().show(
+        ui,
+        |ui| {
+            let (state, actions) = &mut *shared.borrow_mut();
+            run_buttons(ui, &frame, actions);
+            ui.separator();
+            speed_box(ui, state, actions);
+            ui.separator();
+            progress(ui, &frame);
+        },
+        |ui| {
+            let (state, actions) = &mut *shared.borrow_mut();
             rates(ui, state, &frame);
             ui.separator();
             capture_buttons(ui, state, actions);
             ui.separator();
             state_buttons(ui, state, actions);
-        });
-    });
+        },
+    );
 }
 
 /// Play/Pause, Step and Reset.
@@ -109,7 +122,8 @@ fn speed_box(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) 
     }
 }
 
-/// Simulated time, step, Δt, cuts and the run state.
+/// Simulated time, step, the run state, the equilibrium stage's progress, Δt and cuts: the
+/// most wanted first, as a narrow window truncates the end.
 fn progress(ui: &mut egui::Ui, frame: &Frame) {
     let snap = &frame.snapshot;
     ui.label(RichText::new(format!("t = {}", format_time(snap.time))).strong())
@@ -117,15 +131,19 @@ fn progress(ui: &mut egui::Ui, frame: &Frame) {
     ui.label(RichText::new(format!("/ {}", format_time(frame.params.duration))).weak())
         .on_hover_text("End time: the run pauses here; Play continues past it");
     ui.label(format!("step {}", snap.step));
+    let (text, color) = match frame.state {
+        RunState::Running => ("RUNNING", OK_GREEN),
+        RunState::Paused => ("PAUSED", Color32::from_gray(90)),
+        RunState::Finished => ("AT END TIME", Color32::from_rgb(0x2F, 0x5F, 0xB0)),
+        RunState::Failed => ("SOLVER ERROR", ERROR_RED),
+    };
+    ui.label(RichText::new(text).strong().color(color));
     if let Some(r) = snap.equilibrium {
         let text = if r.running {
-            RichText::new(format!(
-                "EQUILIBRIUM STAGE: step {}, R_max {}",
-                r.steps,
-                num(r.residual)
-            ))
-            .strong()
-            .color(STAGE_AMBER)
+            // Short: a narrow window truncates it; the view's caption spells it out.
+            RichText::new(format!("STAGE {}", r.steps))
+                .strong()
+                .color(STAGE_AMBER)
         } else {
             RichText::new(format!("settled in {} steps", r.steps)).weak()
         };
@@ -149,14 +167,6 @@ fn progress(ui: &mut egui::Ui, frame: &Frame) {
             "Time-step cuts so far: attempts redone with a smaller Δt (displacement over \
              δ·w0, or open–close not converging)",
         );
-    ui.separator();
-    let (text, color) = match frame.state {
-        RunState::Running => ("RUNNING", OK_GREEN),
-        RunState::Paused => ("PAUSED", Color32::from_gray(90)),
-        RunState::Finished => ("AT END TIME", Color32::from_rgb(0x2F, 0x5F, 0xB0)),
-        RunState::Failed => ("SOLVER ERROR", ERROR_RED),
-    };
-    ui.label(RichText::new(text).strong().color(color));
 }
 
 /// Frames per second of the window and steps per second of the solver.
