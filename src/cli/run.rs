@@ -19,7 +19,7 @@ use crate::output::{OutputError, RunWriter, Schedule, Summary, slug};
 use crate::params::{Method, Mode};
 use crate::rockmass::report::RockMassReport;
 use crate::scene::OutputSettings;
-use crate::snapshot::Snapshot;
+use crate::snapshot::{EquilibriumReport, Snapshot};
 use crate::solver::{Solver, SolverError};
 use crate::text::short;
 
@@ -118,6 +118,56 @@ impl Progress {
     }
 }
 
+/// The equilibrium stage's progress on stderr: its static steps against
+/// `equilibrium_max_steps` and R_max against its tolerance. A large rock mass's stage runs for
+/// minutes before the first simulated second (the jointed mass of 1000: about 200 s), and the
+/// time bar shows nothing meanwhile. Like [`Progress`], it appears after a second.
+struct StageProgress {
+    bar: ProgressBar,
+    start: Instant,
+    shown: bool,
+    quiet: bool,
+}
+
+impl StageProgress {
+    fn new(max_steps: u32, quiet: bool) -> Self {
+        let bar =
+            ProgressBar::with_draw_target(Some(max_steps.into()), ProgressDrawTarget::hidden());
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] equilibrium stage {bar:40} step {pos}/{len}, {msg}",
+            )
+            .expect("valid template"),
+        );
+        StageProgress {
+            bar,
+            start: Instant::now(),
+            shown: false,
+            quiet,
+        }
+    }
+
+    fn update(&mut self, report: Option<EquilibriumReport>) {
+        let Some(r) = report.filter(|_| !self.quiet) else {
+            return;
+        };
+        if !self.shown && self.start.elapsed() > Duration::from_secs(1) {
+            self.bar.set_draw_target(ProgressDrawTarget::stderr());
+            self.shown = true;
+        }
+        self.bar.set_position(r.steps);
+        self.bar.set_message(format!(
+            "R_max {} (tolerance {})",
+            short(r.residual),
+            short(r.tolerance)
+        ));
+    }
+
+    fn finish(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
 /// Runs the initial equilibrium stage, if the scene has one, and says how it ended: an
 /// unconverged stage is a warning (a block the stage could not bring to rest), not an error.
 /// A stop signal ends the stage early (`Ok(Some(signal))`).
@@ -130,12 +180,20 @@ pub(super) fn settle(
     if !solver.in_equilibrium_stage() && solver.time > 0.0 {
         return Ok(None);
     }
+    let mut bar = StageProgress::new(solver.params.equilibrium_max_steps, quiet);
     while solver.in_equilibrium_stage() {
         if let Some(signal) = exit::interrupted() {
+            bar.finish();
             return Ok(Some(signal));
         }
-        solver.step()?;
+        let stepped = solver.step().map(|_| ());
+        bar.update(solver.equilibrium());
+        if let Err(e) = stepped {
+            bar.finish();
+            return Err(e);
+        }
     }
+    bar.finish();
     match solver.equilibrium() {
         Some(r) if !r.converged => eprintln!(
             "{}: warning: the initial equilibrium stage did not converge: R_max = {} after {} \
