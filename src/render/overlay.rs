@@ -11,8 +11,9 @@ use super::scene::{FieldLegend, RenderScene};
 
 const TEXT: Color32 = Color32::from_rgb(0x20, 0x20, 0x20);
 const TEXT_DIM: Color32 = Color32::from_rgb(0x44, 0x44, 0x44);
-/// The equilibrium stage's line (the viewer's toolbar shows the stage in the same amber).
-const STAGE_AMBER: Color32 = Color32::from_rgb(0xB0, 0x70, 0x10);
+/// The equilibrium stage's colour (the caption's line, the viewer's toolbar label): the run has
+/// not started yet.
+pub const STAGE_AMBER: Color32 = Color32::from_rgb(0xB0, 0x70, 0x10);
 /// Axis colours of the triad: x red, y green, z blue, the CAD convention.
 const AXIS_COLORS: [Color32; 3] = [
     Color32::from_rgb(0xC0, 0x39, 0x2B),

@@ -8,10 +8,7 @@ use egui::{Color32, RichText};
 
 use super::widgets::{ERROR_RED, Icon, OK_GREEN, icon_button, num, seconds};
 use crate::params::table;
-use crate::render::overlay::format_time;
-
-/// The equilibrium stage's label: the run has not started yet.
-const STAGE_AMBER: Color32 = Color32::from_rgb(0xB0, 0x70, 0x10);
+use crate::render::overlay::{STAGE_AMBER, format_time};
 use crate::viewer::sim::{Command, Frame, RunState, Speed};
 use crate::viewer::state::{Action, UiState};
 
