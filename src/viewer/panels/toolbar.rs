@@ -94,10 +94,11 @@ fn run_buttons(ui: &mut egui::Ui, frame: &Frame, actions: &mut Vec<Action>) {
 
 /// The simulation speed (a real-time factor, or as fast as possible).
 fn speed_box(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
-    ui.label("Speed");
+    // No "Speed" label and a narrower box: at the default 1280 px the toolbar had no room left
+    // for Δt and the cuts (the box's own text and tooltip say what it is).
     let before = state.speed;
     egui::ComboBox::from_id_salt("speed")
-        .width(150.0)
+        .width(128.0)
         .selected_text(speed_label(state.speed))
         .show_ui(ui, |ui| {
             for f in SPEEDS {
@@ -157,13 +158,25 @@ fn progress(ui: &mut egui::Ui, frame: &Frame) {
         );
         ui.label(text).on_hover_text(tip);
     }
-    ui.label(format!("Δt {}", seconds(snap.stats.time_step)))
+    // Three significant digits: Δt is chosen, not measured, and the width is scarce.
+    let dt = snap.stats.time_step;
+    let dt = if dt > 0.0 {
+        let digits = 2 - dt.log10().floor() as i32;
+        let scale = 10f64.powi(digits);
+        (dt * scale).round() / scale
+    } else {
+        dt
+    };
+    ui.label(format!("Δt {}", seconds(dt)))
         .on_hover_text("Length of the last accepted step");
-    ui.label(format!("cuts {}", frame.totals.time_step_cuts))
-        .on_hover_text(
+    // Only once there are any: most runs have none, and the toolbar's width is scarce.
+    let cuts = frame.totals.time_step_cuts;
+    if cuts > 0 {
+        ui.label(format!("cuts {cuts}")).on_hover_text(
             "Time-step cuts so far: attempts redone with a smaller Δt (displacement over \
              δ·w0, or open–close not converging)",
         );
+    }
 }
 
 /// Frames per second of the window and steps per second of the solver.
