@@ -73,7 +73,8 @@ impl RunArgs {
     }
 }
 
-/// A progress bar that appears only once a run has taken more than a second.
+/// A progress bar that appears only once a run has taken more than a second: the simulated
+/// time, or the equilibrium stage's static steps ([`Progress::stage`]).
 pub struct Progress {
     bar: ProgressBar,
     start: Instant,
@@ -83,15 +84,25 @@ pub struct Progress {
 
 impl Progress {
     pub fn new(total_seconds: f64, quiet: bool) -> Self {
-        let bar = ProgressBar::with_draw_target(
-            Some((total_seconds * 1000.0).round() as u64),
-            ProgressDrawTarget::hidden(),
-        );
+        let len = (total_seconds * 1000.0).round() as u64;
+        Progress::styled(len, "{bar:40} t = {msg} s (eta {eta})", quiet)
+    }
+
+    /// The equilibrium stage's bar: its static steps against `equilibrium_max_steps`, R_max
+    /// against its tolerance ([`Progress::update_stage`]). A large rock mass's stage runs for
+    /// minutes before the first simulated second (the jointed mass of 1000: about 200 s), and
+    /// the time bar shows nothing meanwhile.
+    fn stage(max_steps: u32, quiet: bool) -> Self {
+        let template = "equilibrium stage {bar:40} step {pos}/{len}, {msg}";
+        Progress::styled(max_steps.into(), template, quiet)
+    }
+
+    /// A hidden bar of `len` units drawn by `template` after the spinner and the elapsed time.
+    fn styled(len: u64, template: &str, quiet: bool) -> Self {
+        let bar = ProgressBar::with_draw_target(Some(len), ProgressDrawTarget::hidden());
         bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] {bar:40} t = {msg} s (eta {eta})",
-            )
-            .expect("valid template"),
+            ProgressStyle::with_template(&format!("{{spinner}} [{{elapsed_precise}}] {template}"))
+                .expect("valid template"),
         );
         Progress {
             bar,
@@ -101,69 +112,40 @@ impl Progress {
         }
     }
 
-    pub fn update(&mut self, time: f64) {
+    /// Whether to update the bar; shows it on stderr once the run has taken a second.
+    fn reveal(&mut self) -> bool {
         if self.quiet {
-            return;
+            return false;
         }
         if !self.shown && self.start.elapsed() > Duration::from_secs(1) {
             self.bar.set_draw_target(ProgressDrawTarget::stderr());
             self.shown = true;
         }
-        self.bar.set_position((time * 1000.0).round() as u64);
-        self.bar.set_message(format!("{time:.3}"));
+        true
+    }
+
+    pub fn update(&mut self, time: f64) {
+        if self.reveal() {
+            self.bar.set_position((time * 1000.0).round() as u64);
+            self.bar.set_message(format!("{time:.3}"));
+        }
+    }
+
+    /// The stage's bar ([`Progress::stage`]) after its latest static step.
+    fn update_stage(&mut self, report: Option<EquilibriumReport>) {
+        if let Some(r) = report
+            && self.reveal()
+        {
+            self.bar.set_position(r.steps);
+            self.bar.set_message(format!(
+                "R_max {} (tolerance {})",
+                short(r.residual),
+                short(r.tolerance)
+            ));
+        }
     }
 
     pub fn finish(&self) {
-        self.bar.finish_and_clear();
-    }
-}
-
-/// The equilibrium stage's progress on stderr: its static steps against
-/// `equilibrium_max_steps` and R_max against its tolerance. A large rock mass's stage runs for
-/// minutes before the first simulated second (the jointed mass of 1000: about 200 s), and the
-/// time bar shows nothing meanwhile. Like [`Progress`], it appears after a second.
-struct StageProgress {
-    bar: ProgressBar,
-    start: Instant,
-    shown: bool,
-    quiet: bool,
-}
-
-impl StageProgress {
-    fn new(max_steps: u32, quiet: bool) -> Self {
-        let bar =
-            ProgressBar::with_draw_target(Some(max_steps.into()), ProgressDrawTarget::hidden());
-        bar.set_style(
-            ProgressStyle::with_template(
-                "{spinner} [{elapsed_precise}] equilibrium stage {bar:40} step {pos}/{len}, {msg}",
-            )
-            .expect("valid template"),
-        );
-        StageProgress {
-            bar,
-            start: Instant::now(),
-            shown: false,
-            quiet,
-        }
-    }
-
-    fn update(&mut self, report: Option<EquilibriumReport>) {
-        let Some(r) = report.filter(|_| !self.quiet) else {
-            return;
-        };
-        if !self.shown && self.start.elapsed() > Duration::from_secs(1) {
-            self.bar.set_draw_target(ProgressDrawTarget::stderr());
-            self.shown = true;
-        }
-        self.bar.set_position(r.steps);
-        self.bar.set_message(format!(
-            "R_max {} (tolerance {})",
-            short(r.residual),
-            short(r.tolerance)
-        ));
-    }
-
-    fn finish(&self) {
         self.bar.finish_and_clear();
     }
 }
@@ -180,14 +162,14 @@ pub(super) fn settle(
     if !solver.in_equilibrium_stage() && solver.time > 0.0 {
         return Ok(None);
     }
-    let mut bar = StageProgress::new(solver.params.equilibrium_max_steps, quiet);
+    let mut bar = Progress::stage(solver.params.equilibrium_max_steps, quiet);
     while solver.in_equilibrium_stage() {
         if let Some(signal) = exit::interrupted() {
             bar.finish();
             return Ok(Some(signal));
         }
         let stepped = solver.step().map(|_| ());
-        bar.update(solver.equilibrium());
+        bar.update_stage(solver.equilibrium());
         if let Err(e) = stepped {
             bar.finish();
             return Err(e);
