@@ -16,14 +16,20 @@ pub fn short(x: f64) -> String {
     }
     // Rounded to DIGITS significant digits first, so that 999 999.9 is 1e6 and 0.00099999
     // is 0.001.
+    let rounded = round_significant(x, DIGITS);
     let sci = format!("{x:.*e}", DIGITS - 1);
-    let rounded: f64 = sci.parse().unwrap_or(x);
     if (1e-3..1e6).contains(&rounded.abs()) {
         let decimals = (DIGITS as i32 - 1 - rounded.abs().log10().floor() as i32).max(0);
         return trim(&format!("{rounded:.*}", decimals as usize));
     }
     let (mantissa, exponent) = sci.split_once('e').unwrap_or((&sci, "0"));
     format!("{}e{exponent}", trim(mantissa))
+}
+
+/// `x` rounded to `digits` (at least 1) significant digits, as its decimal form in scientific
+/// notation rounds it.
+pub fn round_significant(x: f64, digits: usize) -> f64 {
+    format!("{x:.*e}", digits.max(1) - 1).parse().unwrap_or(x)
 }
 
 /// Drops trailing zeros after a decimal point, and the point itself if nothing follows it.
@@ -54,7 +60,7 @@ pub fn one_line(text: &str) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::short;
+    use super::{round_significant, short};
 
     #[test]
     fn numbers_print_short_whatever_their_size() {
@@ -77,5 +83,15 @@ mod tests {
             let back: f64 = short(x).parse().unwrap();
             assert!((back - x).abs() <= 1e-3 * x.abs(), "{x} -> {}", short(x));
         }
+    }
+
+    #[test]
+    fn rounding_keeps_the_significant_digits_asked_for() {
+        assert_eq!(round_significant(5.4356e-3, 3), 5.44e-3);
+        assert_eq!(round_significant(0.009_999_9, 3), 0.01);
+        assert_eq!(round_significant(123_456.0, 2), 120_000.0);
+        assert_eq!(round_significant(-2.345, 1), -2.0);
+        assert_eq!(round_significant(0.0, 3), 0.0);
+        assert_eq!(round_significant(7.0, 0), 7.0);
     }
 }

@@ -8,6 +8,7 @@ use glam::Vec3;
 use super::camera::Camera;
 use super::mesh::{self, LOCK_SRGB, SLIDE_SRGB};
 use super::scene::{FieldLegend, RenderScene};
+use crate::text::short;
 
 const TEXT: Color32 = Color32::from_rgb(0x20, 0x20, 0x20);
 const TEXT_DIM: Color32 = Color32::from_rgb(0x44, 0x44, 0x44);
@@ -125,14 +126,7 @@ fn paint_caption(painter: &egui::Painter, scene: &RenderScene, top_left: Pos2) {
     );
     let stage = scene.caption.stage.map(|(steps, residual)| {
         painter.layout_no_wrap(
-            format!(
-                "equilibrium stage: step {steps}, R_max {}",
-                if (0.01..1000.0).contains(&residual) {
-                    format!("{residual:.3}")
-                } else {
-                    format!("{residual:.2e}")
-                }
-            ),
+            format!("equilibrium stage: step {steps}, R_max {}", short(residual)),
             FontId::proportional(16.0),
             STAGE_AMBER,
         )

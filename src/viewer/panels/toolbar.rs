@@ -9,6 +9,7 @@ use egui::{Color32, RichText};
 use super::widgets::{ERROR_RED, Icon, OK_GREEN, icon_button, num, seconds};
 use crate::params::table;
 use crate::render::overlay::{STAGE_AMBER, format_time};
+use crate::text::round_significant;
 use crate::viewer::sim::{Command, Frame, RunState, Speed};
 use crate::viewer::state::{Action, UiState};
 
@@ -159,16 +160,11 @@ fn progress(ui: &mut egui::Ui, frame: &Frame) {
         ui.label(text).on_hover_text(tip);
     }
     // Three significant digits: Δt is chosen, not measured, and the width is scarce.
-    let dt = snap.stats.time_step;
-    let dt = if dt > 0.0 {
-        let digits = 2 - dt.log10().floor() as i32;
-        let scale = 10f64.powi(digits);
-        (dt * scale).round() / scale
-    } else {
-        dt
-    };
-    ui.label(format!("Δt {}", seconds(dt)))
-        .on_hover_text("Length of the last accepted step");
+    ui.label(format!(
+        "Δt {}",
+        seconds(round_significant(snap.stats.time_step, 3))
+    ))
+    .on_hover_text("Length of the last accepted step");
     // Only once there are any: most runs have none, and the toolbar's width is scarce.
     let cuts = frame.totals.time_step_cuts;
     if cuts > 0 {
