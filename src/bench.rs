@@ -9,7 +9,7 @@ mod threads;
 mod walls;
 
 pub use cutting::cut_table;
-pub use methods::method_table;
+pub use methods::{MAX_PENALTY_FACTOR, method_table};
 pub use rock_masses::rock_mass_table;
 pub use threads::thread_table;
 use walls::scaling_table;

@@ -178,6 +178,8 @@ fn each_method_row_of_the_struck_walls_counts_what_run_counts() {
         duration,
         "--method-sizes",
         &size,
+        "--method-penalties",
+        "10",
     ]);
     let wall = dir.join("wall.toml");
     let status = bin()
@@ -186,12 +188,28 @@ fn each_method_row_of_the_struck_walls_counts_what_run_counts() {
         .status()
         .unwrap();
     assert!(status.success());
+    // The same wall with DDA-3p's penalty ten times p_n,1.
+    let text = std::fs::read_to_string(&wall).unwrap();
+    assert!(text.contains("initial_penalty = 2.0e8\n"), "{text}");
+    let stiff = dir.join("stiff.toml");
+    std::fs::write(
+        &stiff,
+        text.replace("initial_penalty = 2.0e8\n", "initial_penalty = 2.0e9\n"),
+    )
+    .unwrap();
     let mut times = Vec::new();
-    for (method, label) in [("alm", "ALM (DDA-3a)"), ("penalty", "penalty (DDA-3p)")] {
+    for (k, (scene, method, label)) in [
+        (&wall, "alm", "ALM (DDA-3a)"),
+        (&wall, "penalty", "penalty (DDA-3p)"),
+        (&stiff, "penalty", "penalty (DDA-3p), p_n × 10"),
+    ]
+    .into_iter()
+    .enumerate()
+    {
         let cells = row(&stdout, &[&size, label]);
         assert_eq!(cells.len(), 10, "{cells:?}");
         let args = ["--method", method, "--duration", duration];
-        let s = run_summary(&wall, &args, &dir.join(method));
+        let s = run_summary(scene, &args, &dir.join(format!("run{k}")));
         let steps = s["steps"].as_u64().unwrap();
         let per_step = |key: &str| format!("{:.2}", s[key].as_u64().unwrap() as f64 / steps as f64);
         assert_eq!(cells[4], steps.to_string(), "{label}: steps");
@@ -208,6 +226,13 @@ fn each_method_row_of_the_struck_walls_counts_what_run_counts() {
     let penalty = row(&stdout, &[&size, "penalty (DDA-3p)"]);
     assert_eq!(penalty[5], penalty[6], "one solve a pass: {penalty:?}");
     assert_ne!(alm[9], penalty[9], "the two rows ran different methods");
+    let stiff = row(&stdout, &[&size, "penalty (DDA-3p), p_n × 10"]);
+    assert_ne!(
+        stiff[9], penalty[9],
+        "the stiffer penalty ran with its own p_n"
+    );
+    let stiff_ratio = row(&stdout, &[&size, "ALM / penalty, p_n × 10"]);
+    assert_eq!(stiff_ratio.len(), 10, "{stiff_ratio:?}");
     let ratio = row(&stdout, &[&size, "ALM / penalty"]);
     let printed: f64 = ratio[2].parse().unwrap();
     // Both times are printed to the millisecond and the ratio to two decimals: the printed

@@ -36,6 +36,11 @@ pub struct BenchArgs {
     /// `--scaling-duration` s (comma separated, each 1..=99998; empty: no such table).
     #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "100", allow_negative_numbers = true)]
     pub method_sizes: Vec<usize>,
+    /// In the method table, DDA-3p also at these multiples of the walls' p_n,1 = 0.01 E (comma
+    /// separated, each in (0, 10000]; e.g. 10,100,1000): what the penalty method costs at the
+    /// accuracy a stiffer penalty buys.
+    #[arg(long, value_delimiter = ',', num_args = 0.., allow_negative_numbers = true)]
+    pub method_penalties: Vec<f64>,
     /// Rock-mass cutting: boxes cut by three joint sets into about this many blocks (comma
     /// separated, each 1..=100000).
     #[arg(long, value_delimiter = ',', num_args = 0.., default_value = "1000,10000", allow_negative_numbers = true)]
@@ -84,8 +89,12 @@ pub fn bench(args: &BenchArgs) -> Result<(), CliError> {
             .map_err(CliError::Run)?;
     }
     if !args.method_sizes.is_empty() {
-        crate::bench::method_table(&args.method_sizes, args.scaling_duration)
-            .map_err(CliError::Run)?;
+        crate::bench::method_table(
+            &args.method_sizes,
+            args.scaling_duration,
+            &args.method_penalties,
+        )
+        .map_err(CliError::Run)?;
     }
     if !args.cut_sizes.is_empty() {
         crate::bench::cut_table(&args.cut_sizes, args.repeat).map_err(CliError::Run)?;
@@ -120,6 +129,16 @@ fn check_options(args: &BenchArgs) -> Result<(), String> {
         return Err(format!(
             "--cut-sizes: each size must lie in 1..={} blocks, got {n}",
             crate::scene::MAX_BLOCKS
+        ));
+    }
+    let most = crate::bench::MAX_PENALTY_FACTOR;
+    if let Some(f) = args
+        .method_penalties
+        .iter()
+        .find(|f| !(f.is_finite() && **f > 0.0 && **f <= most))
+    {
+        return Err(format!(
+            "--method-penalties: each factor must lie in (0, {most}], got {f}"
         ));
     }
     if !(1..=MAX_REPEAT).contains(&args.repeat) {
