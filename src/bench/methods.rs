@@ -28,7 +28,7 @@ impl Variant {
     fn name(self) -> String {
         match self {
             Variant::Alm => method_name(Method::Alm).into(),
-            Variant::Penalty(f) if f == 1.0 => method_name(Method::Penalty).into(),
+            Variant::Penalty(1.0) => method_name(Method::Penalty).into(),
             Variant::Penalty(f) => format!("{}, p_n × {f}", method_name(Method::Penalty)),
         }
     }
