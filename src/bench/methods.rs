@@ -41,8 +41,13 @@ pub fn method_table(sizes: &[usize], duration: f64, penalties: &[f64]) -> Result
         "\n## Methods: struck walls with ALM (DDA-3a) and penalty (DDA-3p), {duration} s simulated, one run each\n"
     );
     if !penalties.is_empty() {
+        // p_n,1 as the generator writes it (the same for every size).
+        let p1 = generated_wall(1, true, duration)?
+            .params
+            .contact
+            .initial_penalty;
         println!(
-            "DDA-3p also at p_n × {} (p_n = 0.01 E = 2·10⁸ N/m in the walls): its cost at the accuracy a stiffer penalty buys.\n",
+            "DDA-3p also at p_n × {} (p_n = {p1:.1e} N/m in the walls): its cost at the accuracy a stiffer penalty buys.\n",
             penalties
                 .iter()
                 .map(|f| f.to_string())
