@@ -515,13 +515,15 @@ pub(super) fn report(
         (End::Stopped(_), Ok(())) => Ok(()),
         (End::Completed, Ok(())) => {
             if !quiet {
+                let t = &solver.totals;
                 eprintln!(
-                    "{}: {} steps to t = {} s in {} s wall; max penetration {} m; results in {out}",
+                    "{}: {} steps to t = {} s in {} s wall; max penetration {} m{}; results in {out}",
                     rec.scene,
-                    solver.totals.steps,
+                    t.steps,
                     short(solver.time),
                     short(rec.start.elapsed().as_secs_f64()),
-                    short(solver.totals.max_penetration),
+                    short(t.max_penetration),
+                    settled_note(t.unconverged_steps, t.steps),
                 );
             }
             Ok(())
@@ -532,4 +534,29 @@ pub(super) fn report(
 /// `dda3d run`.
 pub fn run(args: &RunArgs) -> Result<(), CliError> {
     execute(args).map_err(CliError::from)
+}
+
+/// The final line's note of the steps whose open–close iteration was settled at its pass limit
+/// rather than converged: those steps' contact states are the solver's best guess, which the
+/// engineer should know of without opening summary.json. Empty when every step converged.
+fn settled_note(settled: u64, steps: u64) -> String {
+    if settled == 0 {
+        String::new()
+    } else {
+        format!("; {settled} of {steps} steps settled at the open–close pass limit")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::settled_note;
+
+    #[test]
+    fn the_final_line_names_settled_steps_only_when_there_are_some() {
+        assert_eq!(settled_note(0, 390), "");
+        assert_eq!(
+            settled_note(78, 126),
+            "; 78 of 126 steps settled at the open–close pass limit"
+        );
+    }
 }
