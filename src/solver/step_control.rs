@@ -151,6 +151,29 @@ pub(crate) fn check_solution(
     d: &[f64],
     active: &[Active],
 ) -> Result<(), Retry> {
+    check_displacement(p, blocks, groups, d)?;
+    let delta = p.max_displacement_ratio;
+    let window = |c: &Active| {
+        let (i, j) = c.blocks();
+        DetectionParams::new(groups.pair_w0(i, j), delta).max_penetration
+    };
+    let beyond = active
+        .iter()
+        .filter(|c| c.rec.state.is_closed() && c.dn > window(c));
+    match beyond.map(|c| c.dn / window(c)).reduce(f64::max) {
+        Some(worst) => Err(Retry::Penetration(worst)),
+        None => Ok(()),
+    }
+}
+
+/// The displacement check of [`check_solution`] alone: no vertex of a block in contact range
+/// moves more than `max_displacement_overshoot · δ·w0`.
+pub(crate) fn check_displacement(
+    p: &SolverParams,
+    blocks: &[Block],
+    groups: &ContactGroups,
+    d: &[f64],
+) -> Result<(), Retry> {
     let delta = p.max_displacement_ratio;
     let mut r: f64 = 0.0;
     for (i, b) in blocks.iter().enumerate() {
@@ -171,17 +194,7 @@ pub(crate) fn check_solution(
     if r > p.max_displacement_overshoot {
         return Err(Retry::Displacement(r));
     }
-    let window = |c: &Active| {
-        let (i, j) = c.blocks();
-        DetectionParams::new(groups.pair_w0(i, j), delta).max_penetration
-    };
-    let beyond = active
-        .iter()
-        .filter(|c| c.rec.state.is_closed() && c.dn > window(c));
-    match beyond.map(|c| c.dn / window(c)).reduce(f64::max) {
-        Some(worst) => Err(Retry::Penetration(worst)),
-        None => Ok(()),
-    }
+    Ok(())
 }
 
 /// The most block pairs a step searches for contacts: each holds a 12×12 block of K (1.2 kB)
