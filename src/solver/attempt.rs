@@ -120,13 +120,11 @@ fn open_close_iteration(
         // energy). Such a solution classifies nothing: the attempt is redone with a shorter Δt
         // at once.
         if !out.converged {
-            runaway(p, inp, &out.d)?;
+            counters.totals.alm_cap_hits += 1;
+            runaway(inp, &out.d)?;
         }
         solved.d = out.d;
         solved.solves += out.solves;
-        if !out.converged {
-            counters.totals.alm_cap_hits += 1;
-        }
         if solved.settled {
             break;
         }
@@ -161,7 +159,8 @@ const RUNAWAY: f64 = 10.0;
 
 /// `Err` when the solution `d` of an ALM loop that did not converge moves a block more than
 /// [`RUNAWAY`] times as far as the step allows.
-fn runaway(p: &SolverParams, inp: &AttemptInputs, d: &[f64]) -> Result<(), Retry> {
+fn runaway(inp: &AttemptInputs, d: &[f64]) -> Result<(), Retry> {
+    let p = inp.params;
     match step_control::check_displacement(p, inp.blocks, inp.groups, d) {
         Err(Retry::Displacement(r)) if r > RUNAWAY * p.max_displacement_overshoot => {
             Err(Retry::Displacement(r))
@@ -217,7 +216,7 @@ mod tests {
         let bound = p.max_displacement_overshoot / r_per_metre;
         for (times, runs_away) in [(0.5, false), (1.01, false), (9.0, false), (11.0, true)] {
             let (_, _, d) = cube_lifted(times * bound);
-            let got = runaway(&p, &inp, &d);
+            let got = runaway(&inp, &d);
             assert_eq!(got.is_err(), runs_away, "{times} times the bound");
         }
     }
