@@ -13,6 +13,9 @@ pub const MAX_WALL_BLOCKS: usize = crate::scene::MAX_BLOCKS - 2;
 /// against (the steps it may take).
 pub const MAX_TIME_STEP: f64 = 0.01;
 
+/// p_n,1 of the generated walls, N/m: the paper's 0.01 E of their rock (E = 2·10¹⁰ Pa).
+pub const INITIAL_PENALTY: f64 = 2.0e8;
+
 /// A wall of `blocks` jointed blocks (1.2 m × 1.2 m × 2.0 m, as in the rockfall scene), stacked
 /// `layers` high in columns standing side by side along y, the bottom layer fixed, struck at
 /// mid-length by a dodecahedral rock thrown at 10 m/s. `blocks = 5, layers = 5` is the paper's
@@ -63,7 +66,7 @@ pub fn column_wall(blocks: usize, layers: usize, rock: bool) -> String {
     );
     let _ = writeln!(
         s,
-        "[solver.contact]\ninitial_penalty = 2.0e8\nalpha = 10.0\nbeta = 0.25\ngamma = 100.0\neps1 = 0.01\neps2 = 0.01\n"
+        "[solver.contact]\ninitial_penalty = {INITIAL_PENALTY:.1e}\nalpha = 10.0\nbeta = 0.25\ngamma = 100.0\neps1 = 0.01\neps2 = 0.01\n"
     );
     let _ = writeln!(s, "[joint]\nfriction_angle = 35.0\ncohesion = 0.0\n");
     let _ = writeln!(

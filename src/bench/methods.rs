@@ -9,6 +9,7 @@
 //! p_n: the cost of the penalty method at the accuracies it can reach, to set DDA-3a against.
 
 use super::{BenchRun, best_of, generated_wall, iterations_per_step, method_name, per_step_ratio};
+use crate::generate::INITIAL_PENALTY;
 use crate::params::Method;
 use crate::solver::SolverError;
 
@@ -24,13 +25,21 @@ enum Variant {
 }
 
 impl Variant {
+    /// What a DDA-3p variant's label adds to the method's name: its penalty, unless p_n,1.
+    fn suffix(self) -> String {
+        match self {
+            Variant::Alm | Variant::Penalty(1.0) => String::new(),
+            Variant::Penalty(f) => format!(", p_n × {f}"),
+        }
+    }
+
     /// The variant as the table names it.
     fn name(self) -> String {
-        match self {
-            Variant::Alm => method_name(Method::Alm).into(),
-            Variant::Penalty(1.0) => method_name(Method::Penalty).into(),
-            Variant::Penalty(f) => format!("{}, p_n × {f}", method_name(Method::Penalty)),
-        }
+        let method = match self {
+            Variant::Alm => Method::Alm,
+            Variant::Penalty(_) => Method::Penalty,
+        };
+        format!("{}{}", method_name(method), self.suffix())
     }
 }
 
@@ -41,13 +50,8 @@ pub fn method_table(sizes: &[usize], duration: f64, penalties: &[f64]) -> Result
         "\n## Methods: struck walls with ALM (DDA-3a) and penalty (DDA-3p), {duration} s simulated, one run each\n"
     );
     if !penalties.is_empty() {
-        // p_n,1 as the generator writes it (the same for every size).
-        let p1 = generated_wall(1, true, duration)?
-            .params
-            .contact
-            .initial_penalty;
         println!(
-            "DDA-3p also at p_n × {} (p_n = {p1:.1e} N/m in the walls): its cost at the accuracy a stiffer penalty buys.\n",
+            "DDA-3p also at p_n × {} (p_n = {INITIAL_PENALTY:.1e} N/m in the walls): its cost at the accuracy a stiffer penalty buys.\n",
             penalties
                 .iter()
                 .map(|f| f.to_string())
@@ -92,9 +96,7 @@ fn ratio_row(
     alm: Option<(f64, f64)>,
     penalty: Option<(f64, f64)>,
 ) -> String {
-    let name = variant
-        .name()
-        .replace(method_name(Method::Penalty), "penalty");
+    let name = format!("penalty{}", variant.suffix());
     match (alm, penalty) {
         (Some(a), Some(p)) => format!(
             "| {n} | ALM / {name} | {:.2} | | {:.2} per step | | | | | |",
