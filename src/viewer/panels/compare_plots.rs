@@ -6,7 +6,7 @@
 use egui::Color32;
 use egui_plot::{Line, LineStyle, PlotPoints};
 
-use super::plots::{plot_title, series, small_plot, thinned};
+use super::plots::{plot_title, record_span, series, small_plot, thinned};
 use super::widgets::ACCENT;
 use crate::viewer::sim::StepRecord;
 use crate::viewer::state::UiState;
@@ -96,7 +96,11 @@ fn overlay(
 ) {
     plot_title(ui, title, tip);
     let (sa, sb) = (series(a, value, f64::max), series(b, value, f64::max));
-    small_plot(id, h).show(ui, |p| {
+    let span = match (record_span(a), record_span(b)) {
+        (Some((a0, a1)), Some((b0, b1))) => Some((a0.min(b0), a1.max(b1))),
+        (one, other) => one.or(other),
+    };
+    small_plot(id, h, span).show(ui, |p| {
         p.line(
             Line::new("A", PlotPoints::from(sa))
                 .color(ACCENT)
@@ -121,7 +125,8 @@ fn difference(
 ) {
     plot_title(ui, title, tip);
     let pts = thinned(points, |p| p[0], value, f64::max);
-    small_plot(id, h).show(ui, |p| {
+    let span = points.first().zip(points.last()).map(|(f, l)| (f[0], l[0]));
+    small_plot(id, h, span).show(ui, |p| {
         p.line(
             Line::new("A − B", PlotPoints::from(pts))
                 .color(Color32::from_rgb(0x6A, 0x3D, 0x9A))

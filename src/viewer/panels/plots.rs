@@ -83,9 +83,31 @@ fn limit_line(name: &str, y: f64) -> HLine {
         .color(Color32::from_gray(110))
 }
 
-pub(super) fn small_plot<'a>(id: &str, height: f32) -> Plot<'a> {
-    Plot::new(id)
-        .height(height)
+/// The shortest time axis a plot shows, s. An equilibrium stage's records all stand at t = 0, and
+/// egui_plot widens a range of zero width by an amount that follows the values plotted: the
+/// contacts' plot, counting thousands, spanned −1000 s to 1000 s while the others spanned a
+/// fraction of a second.
+const MIN_TIME_SPAN: f64 = 0.01;
+
+/// The time axis of plots whose points run from `first` to `last` (None without points): that
+/// range, widened forward to [`MIN_TIME_SPAN`].
+pub(super) fn time_axis(span: Option<(f64, f64)>) -> Option<(f64, f64)> {
+    let (first, last) = span?;
+    Some((first, last.max(first + MIN_TIME_SPAN)))
+}
+
+/// The times of the first and last of `records`.
+pub(super) fn record_span(records: &[StepRecord]) -> Option<(f64, f64)> {
+    Some((records.first()?.time, records.last()?.time))
+}
+
+/// A plot of the panel's style over the time axis [`time_axis`] makes of `span`.
+pub(super) fn small_plot<'a>(id: &str, height: f32, span: Option<(f64, f64)>) -> Plot<'a> {
+    let mut plot = Plot::new(id);
+    if let Some((from, to)) = time_axis(span) {
+        plot = plot.include_x(from).include_x(to);
+    }
+    plot.height(height)
         .allow_zoom(false)
         .allow_drag(false)
         .allow_scroll(false)
@@ -114,7 +136,7 @@ fn penetration(
          ALM target ε1·d_n,max (P23).",
     );
     let pen = series(recs, |r| r.max_penetration * 1e3, f64::max);
-    small_plot("pen", h).show(ui, |p| {
+    small_plot("pen", h, record_span(recs)).show(ui, |p| {
         p.line(
             Line::new("max d_n", PlotPoints::from(pen))
                 .color(ACCENT)
@@ -139,7 +161,7 @@ fn contacts(ui: &mut egui::Ui, recs: &[StepRecord], h: f32) {
     let lock = series(recs, |r| r.lock as f64, f64::max);
     let slide = series(recs, |r| r.slide as f64, f64::max);
     let open = series(recs, |r| r.open as f64, f64::max);
-    small_plot("contacts", h).show(ui, |p| {
+    small_plot("contacts", h, record_span(recs)).show(ui, |p| {
         p.line(Line::new("lock", PlotPoints::from(lock)).color(color32(LOCK_SRGB)));
         p.line(Line::new("slide", PlotPoints::from(slide)).color(color32(SLIDE_SRGB)));
         p.line(Line::new("open", PlotPoints::from(open)).color(color32(OPEN_SRGB)));
@@ -157,7 +179,7 @@ fn iterations(ui: &mut egui::Ui, recs: &[StepRecord], h: f32) {
     let alm = series(recs, |r| r.alm_iterations as f64, f64::max);
     let oc = series(recs, |r| r.open_close_iterations as f64, f64::max);
     let cuts = series(recs, |r| r.cuts as f64, f64::max);
-    small_plot("iters", h).show(ui, |p| {
+    small_plot("iters", h, record_span(recs)).show(ui, |p| {
         p.line(Line::new("ALM solves", PlotPoints::from(alm)).color(ACCENT));
         p.line(
             Line::new("open–close", PlotPoints::from(oc))
@@ -189,7 +211,7 @@ fn penalties(
     let pmax = series(recs, |r| lg(r.penalty_max), f64::max);
     let pmean = series(recs, |r| lg(r.penalty_mean), f64::max);
     let pmin = series(recs, |r| lg(r.penalty_min), f64::min);
-    small_plot("penalty", h)
+    small_plot("penalty", h, record_span(recs))
         .y_axis_formatter(|m, _| num(10f64.powf(m.value)))
         .show(ui, |p| {
             p.line(Line::new("max", PlotPoints::from(pmax)).color(color32(SLIDE_SRGB)));
@@ -211,7 +233,7 @@ fn kinetic_energy(ui: &mut egui::Ui, recs: &[StepRecord], h: f32) {
         "Kinetic energy 1/2 v^T M v summed over all blocks after each step.",
     );
     let ke = series(recs, |r| r.kinetic_energy * 1e-3, f64::max);
-    small_plot("ke", h).show(ui, |p| {
+    small_plot("ke", h, record_span(recs)).show(ui, |p| {
         p.line(
             Line::new("E_k", PlotPoints::from(ke))
                 .color(Color32::from_rgb(0x6A, 0x3D, 0x9A))
@@ -236,5 +258,25 @@ mod tests {
         // Non-finite values (no contacts) are skipped, not plotted as zero.
         let s = series(&r, |r| r.penalty_min, f64::min);
         assert!(s.is_empty());
+    }
+
+    #[test]
+    fn a_time_axis_of_zero_width_is_widened_forward() {
+        // An equilibrium stage: every record at t = 0.
+        let stage: Vec<StepRecord> = (0..5)
+            .map(|k| rec(k, 1.0))
+            .map(|mut r| {
+                r.time = 0.0;
+                r
+            })
+            .collect();
+        assert_eq!(time_axis(record_span(&stage)), Some((0.0, MIN_TIME_SPAN)));
+        // A run's own range is kept where it is wider, and nothing is set without records.
+        assert_eq!(time_axis(Some((0.5, 2.0))), Some((0.5, 2.0)));
+        assert_eq!(
+            time_axis(Some((1.0, 1.004))),
+            Some((1.0, 1.0 + MIN_TIME_SPAN))
+        );
+        assert_eq!(time_axis(record_span(&[])), None);
     }
 }
