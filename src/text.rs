@@ -15,9 +15,9 @@ pub fn short(x: f64) -> String {
         return "0".to_string();
     }
     // Rounded to DIGITS significant digits first, so that 999 999.9 is 1e6 and 0.00099999
-    // is 0.001.
-    let rounded = round_significant(x, DIGITS);
+    // is 0.001 (what `round_significant(x, DIGITS)` gives, from the one formatting).
     let sci = format!("{x:.*e}", DIGITS - 1);
+    let rounded: f64 = sci.parse().unwrap_or(x);
     if (1e-3..1e6).contains(&rounded.abs()) {
         let decimals = (DIGITS as i32 - 1 - rounded.abs().log10().floor() as i32).max(0);
         return trim(&format!("{rounded:.*}", decimals as usize));
