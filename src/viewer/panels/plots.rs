@@ -89,14 +89,15 @@ fn limit_line(name: &str, y: f64) -> HLine {
 /// fraction of a second.
 const MIN_TIME_SPAN: f64 = 0.01;
 
-/// The time axis of plots whose points run from `first` to `last` (None without points): that
-/// range, widened forward to [`MIN_TIME_SPAN`].
+/// The time axis of a plot whose points run over `span`, (first, last) in s (None without
+/// points): that range, its end moved forward to make it at least [`MIN_TIME_SPAN`] wide.
 pub(super) fn time_axis(span: Option<(f64, f64)>) -> Option<(f64, f64)> {
     let (first, last) = span?;
     Some((first, last.max(first + MIN_TIME_SPAN)))
 }
 
-/// The times of the first and last of `records`.
+/// The times of the first and last of `records` (kept in the order of their steps, so these are
+/// the least and the greatest).
 pub(super) fn record_span(records: &[StepRecord]) -> Option<(f64, f64)> {
     Some((records.first()?.time, records.last()?.time))
 }
