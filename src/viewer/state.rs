@@ -475,6 +475,7 @@ pub(super) mod tests {
             penalty_min: f64::NAN,
             penalty_mean: f64::NAN,
             penalty_max: f64::NAN,
+            stage: None,
         }
     }
 

@@ -7,6 +7,7 @@ use egui_plot::{HLine, Legend, Line, LineStyle, Plot, PlotPoints};
 use super::widgets::{ACCENT, color32, num};
 use crate::params::{Method, SolverParams};
 use crate::render::mesh::{LOCK_SRGB, OPEN_SRGB, SLIDE_SRGB};
+use crate::render::overlay::STAGE_AMBER;
 use crate::viewer::sim::StepRecord;
 use crate::viewer::state::UiState;
 
@@ -26,8 +27,17 @@ pub fn show(ui: &mut egui::Ui, state: &UiState) {
     let young = state.scene_file.young;
     let h = (ui.available_height() - 22.0).max(60.0);
     ui.add_space(2.0);
+    let stage_tolerance = state
+        .frame
+        .as_ref()
+        .and_then(|f| f.snapshot.equilibrium)
+        .map(|r| r.tolerance);
     ui.columns(5, |cols| {
-        penetration(&mut cols[0], recs, params, dn_max, h);
+        if recs.last().is_some_and(|r| r.stage.is_some()) {
+            stage_residual(&mut cols[0], recs, stage_tolerance, h);
+        } else {
+            penetration(&mut cols[0], recs, params, dn_max, h);
+        }
         contacts(&mut cols[1], recs, h);
         iterations(&mut cols[2], recs, h);
         penalties(&mut cols[3], recs, params, young, h);
@@ -152,6 +162,47 @@ fn penetration(
     });
 }
 
+/// The initial equilibrium stage's R_max after each of its static steps, as log10, by step
+/// (at most [`PLOT_POINTS`] points, each the largest of its run of steps).
+fn stage_series(records: &[StepRecord]) -> Vec<[f64; 2]> {
+    let stage: Vec<(u64, f64)> = records
+        .iter()
+        .filter_map(|r| r.stage)
+        .filter(|&(_, residual)| residual > 0.0)
+        .collect();
+    thinned(&stage, |s| s.0 as f64, |s| s.1.log10(), f64::max)
+}
+
+/// While the initial equilibrium stage runs, R_max by stage step (log scale) with its tolerance
+/// dashed, in place of the penetration: time stands at 0 then, so the plots over time show
+/// nothing of the stage's progress.
+fn stage_residual(ui: &mut egui::Ui, recs: &[StepRecord], tolerance: Option<f64>, h: f32) {
+    plot_title(
+        ui,
+        "Equilibrium stage: R_max",
+        "Largest unbalanced force of a free block over the forces it carries, after each \
+         static step of the initial equilibrium stage (log scale). The stage ends when it falls \
+         below the tolerance (dashed), or at its step limit.",
+    );
+    let points = stage_series(recs);
+    let last = points.last().map_or(0.0, |p| p[0]);
+    small_plot("stage", h, None)
+        .include_x(0.0)
+        .include_x(last.max(10.0))
+        .x_axis_formatter(|m, _| format!("step {}", num(m.value)))
+        .y_axis_formatter(|m, _| num(10f64.powf(m.value)))
+        .show(ui, |p| {
+            p.line(
+                Line::new("R_max", PlotPoints::from(points))
+                    .color(STAGE_AMBER)
+                    .width(1.5),
+            );
+            if let Some(tol) = tolerance.filter(|t| *t > 0.0) {
+                p.hline(limit_line("tolerance", tol.log10()));
+            }
+        });
+}
+
 /// Contacts by state.
 fn contacts(ui: &mut egui::Ui, recs: &[StepRecord], h: f32) {
     plot_title(
@@ -259,6 +310,18 @@ mod tests {
         // Non-finite values (no contacts) are skipped, not plotted as zero.
         let s = series(&r, |r| r.penalty_min, f64::min);
         assert!(s.is_empty());
+    }
+
+    #[test]
+    fn the_stage_is_plotted_by_step_and_the_run_is_left_out() {
+        let mut r: Vec<StepRecord> = (0..6).map(|k| rec(k, 1.0)).collect();
+        for (k, rec) in r.iter_mut().enumerate().take(4) {
+            rec.stage = Some((k as u64 + 1, 10f64.powi(-(k as i32))));
+        }
+        // A stage step with R_max 0 has no logarithm: left out, not plotted at −∞.
+        r[3].stage = Some((4, 0.0));
+        let s = stage_series(&r);
+        assert_eq!(s, vec![[1.0, 0.0], [2.0, -1.0], [3.0, -2.0]]);
     }
 
     #[test]

@@ -114,4 +114,7 @@ pub struct StepRecord {
     pub penalty_min: f64,
     pub penalty_mean: f64,
     pub penalty_max: f64,
+    /// A static step of the initial equilibrium stage: its number in the stage and R_max after
+    /// it (`None` for the run's own steps, and for the stage's last, which ends it).
+    pub stage: Option<(u64, f64)>,
 }

@@ -372,6 +372,11 @@ impl Sim {
                     penalty_min: pmin,
                     penalty_mean: pmean,
                     penalty_max: pmax,
+                    stage: self
+                        .solver
+                        .equilibrium()
+                        .filter(|r| r.running)
+                        .map(|r| (r.steps, r.residual)),
                 });
                 self.rate_steps += 1;
                 self.rate_busy += busy;
