@@ -102,6 +102,14 @@ impl SweepRange {
     }
 }
 
+/// The most block pairs a step searches for contacts: each holds a 12×12 block of K (1.2 kB)
+/// and its candidate contacts several kB more. A wall of 10 000 blocks has about 10⁵. Slabs of
+/// a joint set spaced 1 mm apart, far thinner than the contact search distance 2.5·δ·w0, made
+/// 2·10⁷ pairs among 16 000 blocks, and the run was killed for its memory (24 GB) before its
+/// first step. The searches stop just past it ([`SweepIndex::pairs`]): the list itself, at
+/// 16 bytes a pair, took 4.7 GB for 20 000 slabs 0.1 mm thick before the count was checked.
+pub const MAX_BLOCK_PAIRS: usize = 2_000_000;
+
 /// A box longer along the sweep axis than this many times the median box is kept in a range of
 /// its own for [`SweepIndex::near`]. A range query must reach back by the longest box's extent:
 /// with a 248 m ground slab under a wall of 1.2 m blocks, every query scanned every block before
@@ -144,18 +152,20 @@ impl SweepIndex {
 
     /// Pairs (a, b), a < b, sorted, whose boxes come within `window(a, b)` of each other on
     /// every axis; `window` must not exceed `max_window`. Pairs of two fixed blocks are kept
-    /// only if `fixed_pairs`.
+    /// only if `fixed_pairs`. The search stops once it has found more than `limit` pairs (and
+    /// returns those): the caller refuses the step.
     pub fn pairs(
         &self,
         boxes: &[Bounds],
         max_window: f64,
         fixed_pairs: bool,
         window: impl Fn(usize, usize) -> f64,
+        limit: usize,
     ) -> Vec<(usize, usize)> {
         let axis = self.axis;
         let h = max_window / 2.0;
         let mut pairs = Vec::new();
-        for (k, &a) in self.order.iter().enumerate() {
+        'sweep: for (k, &a) in self.order.iter().enumerate() {
             let sa = &boxes[a];
             for &b in &self.order[k + 1..] {
                 let sb = &boxes[b];
@@ -168,6 +178,9 @@ impl SweepIndex {
                 }
                 if within(sa, sb, window(a, b)) {
                     pairs.push((a.min(b), a.max(b)));
+                    if pairs.len() > limit {
+                        break 'sweep;
+                    }
                 }
             }
         }
@@ -254,8 +267,27 @@ impl ContactGroups {
             let own: Vec<f64> = (0..n).map(|k| w0[root(&parent, k)].min(cap[k])).collect();
             let widest = own.iter().copied().fold(0.0, f64::max);
             let window = |a: usize, b: usize| search_distance(own[a].max(own[b]), delta);
-            let linked = index.pairs(&boxes, search_distance(widest, delta), true, window);
+            let linked = index.pairs(
+                &boxes,
+                search_distance(widest, delta),
+                true,
+                window,
+                MAX_BLOCK_PAIRS,
+            );
+            // Too many pairs to search: the step is refused on their count, the groups unused.
             let mut merged = false;
+            if linked.len() > MAX_BLOCK_PAIRS {
+                return ContactGroups {
+                    group: (0..n).collect(),
+                    largest: w0.iter().copied().fold(0.0, f64::max),
+                    w0,
+                    cap,
+                    pairs: linked,
+                    boxes,
+                    index,
+                    delta,
+                };
+            }
             for &(a, b) in &linked {
                 let (ra, rb) = (root(&parent, a), root(&parent, b));
                 if ra != rb {
@@ -523,7 +555,13 @@ mod tests {
                 .collect();
             assert_eq!(fast, slow, "block {i}");
         }
-        let pairs = index.pairs(&boxes, 0.3, true, |a, b| 0.1 * ((a + b) % 4) as f64);
+        let pairs = index.pairs(
+            &boxes,
+            0.3,
+            true,
+            |a, b| 0.1 * ((a + b) % 4) as f64,
+            MAX_BLOCK_PAIRS,
+        );
         let mut slow = Vec::new();
         for a in 0..boxes.len() {
             for b in a + 1..boxes.len() {
@@ -533,5 +571,10 @@ mod tests {
             }
         }
         assert_eq!(pairs, slow);
+        // Past its limit the search stops: one pair more than the limit, each a true pair.
+        let capped = index.pairs(&boxes, 0.3, true, |a, b| 0.1 * ((a + b) % 4) as f64, 10);
+        assert!(slow.len() > 11);
+        assert_eq!(capped.len(), 11);
+        assert!(capped.iter().all(|p| slow.contains(p)));
     }
 }

@@ -6,6 +6,7 @@ use super::format::{BlockSpec, ShapeSpec};
 use super::{MAX_BLOCK_POINTS, MAX_HULL_VERTICES};
 use crate::contact::Shape;
 use crate::contact::detection::broad_phase;
+use crate::contact::groups::MAX_BLOCK_PAIRS;
 use crate::model::Block;
 use crate::physics::geometry::{
     Vec3, bounding_box, box_vertices, convex_hull, dodecahedron_vertices, overlap_depth,
@@ -216,7 +217,20 @@ pub(super) fn check_overlaps(blocks: &[Block]) -> Result<(), (usize, String)> {
             ..Shape::of(b)
         })
         .collect();
-    for (a, b) in broad_phase(&shapes, 0.0) {
+    let pairs = broad_phase(&shapes, 0.0, MAX_BLOCK_PAIRS);
+    if let Some(&(_, b)) = pairs.get(MAX_BLOCK_PAIRS) {
+        // Each pair would be checked here, and searched for contacts at every step.
+        return Err((
+            b,
+            format!(
+                "more than {} pairs of blocks have overlapping bounding boxes, more than a run \
+                 can search for contacts: blocks far thinner than they are long (a joint set \
+                 spaced far closer than the blocks are long?) each lie across hundreds of others",
+                short(MAX_BLOCK_PAIRS as f64)
+            ),
+        ));
+    }
+    for (a, b) in pairs {
         let depth = overlap_depth(
             &blocks[a].vertices,
             &blocks[a].topo,

@@ -5,7 +5,7 @@
 
 use super::active::Active;
 use crate::contact::DetectionParams;
-use crate::contact::groups::ContactGroups;
+use crate::contact::groups::{ContactGroups, MAX_BLOCK_PAIRS};
 use crate::model::Block;
 use crate::params::step_rules::{
     DISPLACEMENT_CUT_SAFETY, DT_CUT, DT_FLOOR_DIVISOR, DT_GROWTH, PREDICT_SAFETY,
@@ -197,23 +197,16 @@ pub(crate) fn check_displacement(
     Ok(())
 }
 
-/// The most block pairs a step searches for contacts: each holds a 12×12 block of K (1.2 kB)
-/// and its candidate contacts several kB more. A wall of 10 000 blocks has about 10⁵. Slabs of
-/// a joint set spaced 1 mm apart, far thinner than the contact search distance 2.5·δ·w0, made
-/// 2·10⁷ pairs among 16 000 blocks, and the run was killed for its memory (24 GB) before its
-/// first step.
-pub(crate) const MAX_BLOCK_PAIRS: usize = 2_000_000;
-
-/// `Err` with the reason when a step would search more than [`MAX_BLOCK_PAIRS`] block pairs.
+/// `Err` with the reason when a step would search more than [`MAX_BLOCK_PAIRS`] block pairs
+/// (the search stops counting just past it).
 pub(crate) fn check_pair_count(pairs: usize, w0: f64, delta: f64) -> Result<(), String> {
     if pairs <= MAX_BLOCK_PAIRS {
         return Ok(());
     }
     Err(format!(
-        "the contact search finds {} block pairs, more than the {} a step can hold in memory: \
+        "the contact search finds more block pairs than the {} a step can hold in memory: \
          blocks far thinner than the search distance {} m (2.5·δ·w0) each reach hundreds of \
          others; make them thicker or lower max_displacement_ratio",
-        short(pairs as f64),
         short(MAX_BLOCK_PAIRS as f64),
         short(crate::contact::groups::search_distance(w0, delta))
     ))

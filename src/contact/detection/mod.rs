@@ -6,8 +6,9 @@ use super::{Alternative, Candidate, ContactKey, DetectionParams, Shape};
 use crate::physics::geometry::Vec3;
 
 /// Candidate block pairs by sort-and-sweep on the x extent of the enlarged bounding boxes.
-/// Pairs of two fixed blocks are skipped. Returns pairs (a, b) with a < b.
-pub fn broad_phase(shapes: &[Shape], margin: f64) -> Vec<(usize, usize)> {
+/// Pairs of two fixed blocks are skipped. Returns pairs (a, b) with a < b; the sweep stops once
+/// it has found more than `limit` (see [`crate::contact::groups::MAX_BLOCK_PAIRS`]).
+pub fn broad_phase(shapes: &[Shape], margin: f64, limit: usize) -> Vec<(usize, usize)> {
     let mut order: Vec<usize> = (0..shapes.len()).collect();
     // Sweep along the longest axis of the model.
     let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
@@ -19,7 +20,7 @@ pub fn broad_phase(shapes: &[Shape], margin: f64) -> Vec<(usize, usize)> {
     order.sort_by(|&a, &b| shapes[a].lo[axis].total_cmp(&shapes[b].lo[axis]));
     let h = margin / 2.0;
     let mut pairs = Vec::new();
-    for (k, &a) in order.iter().enumerate() {
+    'sweep: for (k, &a) in order.iter().enumerate() {
         let sa = &shapes[a];
         for &b in &order[k + 1..] {
             let sb = &shapes[b];
@@ -33,6 +34,9 @@ pub fn broad_phase(shapes: &[Shape], margin: f64) -> Vec<(usize, usize)> {
                 (0..3).all(|d| sa.lo[d] - h <= sb.hi[d] + h && sb.lo[d] - h <= sa.hi[d] + h);
             if overlap {
                 pairs.push((a.min(b), a.max(b)));
+                if pairs.len() > limit {
+                    break 'sweep;
+                }
             }
         }
     }

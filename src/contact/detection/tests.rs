@@ -267,7 +267,7 @@ fn far_blocks_have_no_contacts_and_broad_phase_skips_them() {
     let b = owned(box_vertices([1.0; 3], [3.0, 0.0, 0.0], &Mat3::identity()));
     let d = owned(box_vertices([1.0; 3], [0.0, 0.0, 1.05], &Mat3::identity()));
     let shapes = [shape(&a), shape(&b), shape(&d)];
-    assert_eq!(broad_phase(&shapes, 0.125), vec![(0, 2)]);
+    assert_eq!(broad_phase(&shapes, 0.125, 10), vec![(0, 2)]);
     let c = detect_pair(0, &shapes[0], 2, &shapes[2], &params(), &|_| false);
     assert_eq!(c.len(), 4, "gap 5 cm < d_s = 12.5 cm");
 }
