@@ -218,14 +218,16 @@ pub(super) fn check_overlaps(blocks: &[Block]) -> Result<(), (usize, String)> {
         })
         .collect();
     let pairs = broad_phase(&shapes, 0.0, MAX_BLOCK_PAIRS);
+    // Each pair would be checked here, and (unless both are fixed) searched for contacts at
+    // every step. The error names the line of a block of one of them.
     if let Some(&(_, b)) = pairs.get(MAX_BLOCK_PAIRS) {
-        // Each pair would be checked here, and searched for contacts at every step.
         return Err((
             b,
             format!(
-                "more than {} pairs of blocks have overlapping bounding boxes, more than a run \
-                 can search for contacts: blocks far thinner than they are long (a joint set \
-                 spaced far closer than the blocks are long?) each lie across hundreds of others",
+                "more than {} pairs of blocks have overlapping bounding boxes, too many to check \
+                 for overlap or to search for contacts: blocks far thinner than they are long (a \
+                 joint set spaced far closer than the blocks are long?) each lie across hundreds \
+                 of others",
                 short(MAX_BLOCK_PAIRS as f64)
             ),
         ));
