@@ -152,8 +152,8 @@ impl SweepIndex {
 
     /// Pairs (a, b), a < b, sorted, whose boxes come within `window(a, b)` of each other on
     /// every axis; `window` must not exceed `max_window`. Pairs of two fixed blocks are kept
-    /// only if `fixed_pairs`. The search stops once it has found more than `limit` pairs (and
-    /// returns those): the caller refuses the step.
+    /// only if `fixed_pairs`. The search stops once it has found more than `limit` pairs with a
+    /// movable block (and returns what it found): the caller refuses the step.
     pub fn pairs(
         &self,
         boxes: &[Bounds],
@@ -165,6 +165,7 @@ impl SweepIndex {
         let axis = self.axis;
         let h = max_window / 2.0;
         let mut pairs = Vec::new();
+        let mut movable = 0;
         'sweep: for (k, &a) in self.order.iter().enumerate() {
             let sa = &boxes[a];
             for &b in &self.order[k + 1..] {
@@ -178,7 +179,8 @@ impl SweepIndex {
                 }
                 if within(sa, sb, window(a, b)) {
                     pairs.push((a.min(b), a.max(b)));
-                    if pairs.len() > limit {
+                    movable += usize::from(!(sa.fixed && sb.fixed));
+                    if movable > limit {
                         break 'sweep;
                     }
                 }
@@ -274,20 +276,9 @@ impl ContactGroups {
                 window,
                 MAX_BLOCK_PAIRS,
             );
-            // Too many pairs to search: the step is refused on their count, the groups unused.
+            // Past MAX_BLOCK_PAIRS pairs with a movable block the search stopped: the groups
+            // found from what it found carry those pairs, and the step is refused on their count.
             let mut merged = false;
-            if linked.len() > MAX_BLOCK_PAIRS {
-                return ContactGroups {
-                    group: (0..n).collect(),
-                    largest: w0.iter().copied().fold(0.0, f64::max),
-                    w0,
-                    cap,
-                    pairs: linked,
-                    boxes,
-                    index,
-                    delta,
-                };
-            }
             for &(a, b) in &linked {
                 let (ra, rb) = (root(&parent, a), root(&parent, b));
                 if ra != rb {

@@ -2,46 +2,25 @@
 //! and the narrow phase's two entrance modes, vertex-to-face and edge-to-edge, with the merging
 //! of candidates that are one physical constraint.
 
+use super::groups::{Bounds, SweepIndex};
 use super::{Alternative, Candidate, ContactKey, DetectionParams, Shape};
 use crate::physics::geometry::Vec3;
 
-/// Candidate block pairs by sort-and-sweep on the x extent of the enlarged bounding boxes.
-/// Pairs of two fixed blocks are skipped. Returns pairs (a, b) with a < b; the sweep stops once
-/// it has found more than `limit` (see [`crate::contact::groups::MAX_BLOCK_PAIRS`]).
+/// Candidate block pairs by sort-and-sweep on the enlarged bounding boxes (the sweep of
+/// [`SweepIndex::pairs`], every box grown by `margin / 2`). Pairs of two fixed blocks are
+/// skipped. Returns pairs (a, b) with a < b; the sweep stops once it has found more than
+/// `limit` (see [`crate::contact::groups::MAX_BLOCK_PAIRS`]).
 pub fn broad_phase(shapes: &[Shape], margin: f64, limit: usize) -> Vec<(usize, usize)> {
-    let mut order: Vec<usize> = (0..shapes.len()).collect();
-    // Sweep along the longest axis of the model.
-    let (mut lo, mut hi) = (Vec3::repeat(f64::INFINITY), Vec3::repeat(f64::NEG_INFINITY));
-    for s in shapes {
-        lo = lo.inf(&s.lo);
-        hi = hi.sup(&s.hi);
-    }
-    let axis = (hi - lo).imax();
-    order.sort_by(|&a, &b| shapes[a].lo[axis].total_cmp(&shapes[b].lo[axis]));
-    let h = margin / 2.0;
-    let mut pairs = Vec::new();
-    'sweep: for (k, &a) in order.iter().enumerate() {
-        let sa = &shapes[a];
-        for &b in &order[k + 1..] {
-            let sb = &shapes[b];
-            if sb.lo[axis] - h > sa.hi[axis] + h {
-                break;
-            }
-            if sa.fixed && sb.fixed {
-                continue;
-            }
-            let overlap =
-                (0..3).all(|d| sa.lo[d] - h <= sb.hi[d] + h && sb.lo[d] - h <= sa.hi[d] + h);
-            if overlap {
-                pairs.push((a.min(b), a.max(b)));
-                if pairs.len() > limit {
-                    break 'sweep;
-                }
-            }
-        }
-    }
-    pairs.sort_unstable();
-    pairs
+    let boxes: Vec<Bounds> = shapes
+        .iter()
+        .map(|s| Bounds {
+            lo: s.lo,
+            hi: s.hi,
+            initial: (s.lo, s.hi),
+            fixed: s.fixed,
+        })
+        .collect();
+    SweepIndex::new(&boxes).pairs(&boxes, margin, false, |_, _| margin, limit)
 }
 
 /// The bounding box of a block grown by the search distance: the cull that opens both
