@@ -51,6 +51,20 @@ fn run_error(dir: &Path, text: &str, what: &str) -> String {
     err
 }
 
+/// `dda3d run` of `text`, written to `NAME.toml`, for 0.01 s: it must succeed.
+fn run_briefly(dir: &Path, name: &str, text: &str) {
+    let path = dir.join(format!("{name}.toml"));
+    std::fs::write(&path, text).unwrap();
+    let out = bin()
+        .arg("run")
+        .arg(&path)
+        .args(["--quiet", "--duration", "0.01", "--out"])
+        .arg(dir.join(name))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{name}: {out:?}");
+}
+
 /// A value of the wrong kind, or a table that lacks a key, is named by its key: an inline
 /// table where a number belongs, and a block without its material (before: "line 2: invalid
 /// type: map, expected f64" and "line 5: missing field `material`", no key).
@@ -453,16 +467,7 @@ fn blocks_and_points_are_bounded() {
         err.contains("convex hull has 5000 corners, more than the limit of 4096"),
         "{err}"
     );
-    let path = dir.join("sphere.toml");
-    std::fs::write(&path, sphere(4000)).unwrap();
-    let status = bin()
-        .arg("run")
-        .arg(&path)
-        .args(["--quiet", "--duration", "0.01", "--out"])
-        .arg(dir.join("s"))
-        .output()
-        .unwrap();
-    assert!(status.status.success(), "{status:?}");
+    run_briefly(&dir, "sphere", &sphere(4000));
 }
 
 /// `generate` writes only scenes that load, and `bench` checks its sizes before it builds any.
@@ -637,16 +642,11 @@ fn slabs_thinner_than_long_by_thousands_are_refused_at_load() {
         "{err}"
     );
     // Slabs a tenth of the domain thick are a rock mass like any other.
-    let path = dir.join("good.toml");
-    std::fs::write(&path, rock_mass("{ below = 0.5 }", 0.4, "[0, 0, 0]")).unwrap();
-    let out = bin()
-        .arg("run")
-        .arg(&path)
-        .args(["--quiet", "--duration", "0.01", "--out"])
-        .arg(dir.join("good"))
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{out:?}");
+    run_briefly(
+        &dir,
+        "good",
+        &rock_mass("{ below = 0.5 }", 0.4, "[0, 0, 0]"),
+    );
 }
 
 /// `render`'s frame count, duration × fps, is bounded before anything is drawn (no GPU needed).
