@@ -7,7 +7,7 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
-use super::active::Active;
+use super::active::{Active, initial_friction_normal};
 use super::counters::debug_log;
 use super::step_control::max_step_penetration;
 use super::{PAR_BLOCKS, PAR_CONTACTS, PAR_PAIRS};
@@ -189,13 +189,8 @@ fn activate_one(
     }
     let unseen = old.is_none_or(|r| r.state == ContactState::Open);
     keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen, w0);
-    // The force the last step ended with (its λ carries less: `commit::commit_contact`); a
-    // new record's is 0, as is every λ without the warm start.
-    let friction_normal = if p.contact.warm_start && p.method == Method::Alm {
-        rec.normal_force.max(0.0)
-    } else {
-        0.0
-    };
+    // A new record's is 0, as is every λ without the warm start.
+    let friction_normal = initial_friction_normal(p, &rec);
     let active = Active {
         joint: joint_set(&cand.key, bi, bj),
         kin,

@@ -213,6 +213,15 @@ impl Active {
         }
     }
 
+    /// Back to the start of the step for another attempt: its record, and the normal force its
+    /// friction takes, as activation set it. (The record alone was restored: an attempt redone
+    /// after an ALM loop had run away began with that loop's friction, 10²¹⁷ N, and every
+    /// shorter Δt failed in its first solve until the run was declared diverged.)
+    pub fn restart(&mut self, p: &SolverParams) {
+        self.rec = self.start;
+        self.friction_normal = initial_friction_normal(p, &self.start);
+    }
+
     /// Drops the contact's normal force: its multiplier λ, the force its friction takes and
     /// the multiplier it would carry into the next step (a contact that opens, closes afresh,
     /// or lets go of a tension it cannot hold).
@@ -429,5 +438,72 @@ impl Active {
     /// T_b at the point `xb` of block j.
     pub fn tb_at(&self, xb: &Vec3, blocks: &[Block]) -> Mat3x12 {
         displacement_matrix(&(xb - blocks[self.cand.key.j as usize].mp.centroid))
+    }
+}
+
+/// The normal force a contact's friction takes at the start of a step: the force the last step
+/// ended with under the ALM's warm start (its λ carries less: `commit::commit_contact`), else 0.
+pub(crate) fn initial_friction_normal(p: &SolverParams, start: &ContactRecord) -> f64 {
+    if p.contact.warm_start && p.method == Method::Alm {
+        start.normal_force.max(0.0)
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::Solver;
+    use crate::solver::activate::{ActivationInputs, activate};
+
+    /// A cube resting on a slab after a few steps: its contacts for the next step, each with the
+    /// normal force the last step ended with.
+    fn resting_cube() -> (Solver, Vec<Active>) {
+        let text = "[materials.rock]\ndensity = 2700.0\nyoung_modulus = 2.0e10\npoisson_ratio = 0.25\n\
+             [[blocks]]\nname = \"slab\"\nmaterial = \"rock\"\nfixed = true\n\
+             box = { size = [4.0, 4.0, 1.0], center = [0.0, 0.0, -0.5] }\n\
+             [[blocks]]\nname = \"cube\"\nmaterial = \"rock\"\n\
+             box = { size = [1.0, 1.0, 1.0], center = [0.0, 0.0, 0.5] }\n";
+        let s = crate::scene::parse(text, "cube.toml", "cube").expect("scene parses");
+        let mut solver = Solver::new(s.model, s.params);
+        for _ in 0..3 {
+            solver.step().expect("steps");
+        }
+        let inputs = ActivationInputs {
+            params: &solver.params,
+            blocks: &solver.model.blocks,
+            records: &solver.records,
+            step: solver.step,
+            time: solver.time,
+            dt: solver.dt,
+        };
+        let (active, _) = activate(&inputs, &solver.initial_boxes);
+        (solver, active)
+    }
+
+    /// A redone attempt starts from the step's start: the record and the normal force friction
+    /// takes, whatever the failed attempt left in them.
+    #[test]
+    fn a_restarted_contact_takes_up_its_friction_from_the_start_of_the_step() {
+        let (solver, mut active) = resting_cube();
+        let p = &solver.params;
+        assert!(
+            active.iter().any(|c| c.friction_normal > 0.0),
+            "the cube bears on the slab"
+        );
+        let before: Vec<f64> = active.iter().map(|c| c.friction_normal).collect();
+        for c in active.iter_mut() {
+            c.rec.lambda = 1e217;
+            c.rec.state = ContactState::Slide;
+            c.friction_normal = 1e217;
+        }
+        for (c, &n0) in active.iter_mut().zip(&before) {
+            c.restart(p);
+            assert_eq!(c.rec.state, c.start.state);
+            assert_eq!(c.rec.lambda, c.start.lambda);
+            assert_eq!(c.friction_normal, n0);
+            assert_eq!(n0, initial_friction_normal(p, &c.start));
+        }
     }
 }

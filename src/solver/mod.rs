@@ -527,7 +527,7 @@ impl Solver {
                     dt = reason.shortened(dt, floor);
                     cuts += 1;
                     for c in active.iter_mut() {
-                        c.rec = c.start;
+                        c.restart(&self.params);
                     }
                 }
             }
