@@ -189,7 +189,7 @@ fn activate_one(
     }
     let unseen = old.is_none_or(|r| r.state == ContactState::Open);
     keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen, w0);
-    // A new record's is 0, as is every λ without the warm start.
+    // The force the last step ended with, under the warm start (a new record's is 0).
     let friction_normal = initial_friction_normal(p, &rec);
     let active = Active {
         joint: joint_set(&cand.key, bi, bj),
