@@ -455,30 +455,17 @@ pub(crate) fn initial_friction_normal(p: &SolverParams, start: &ContactRecord) -
 mod tests {
     use super::*;
     use crate::solver::Solver;
-    use crate::solver::activate::{ActivationInputs, activate};
 
     /// A cube resting on a slab after a few steps: its contacts for the next step, each with the
     /// normal force the last step ended with.
     fn resting_cube() -> (Solver, Vec<Active>) {
-        let text = "[materials.rock]\ndensity = 2700.0\nyoung_modulus = 2.0e10\npoisson_ratio = 0.25\n\
-             [[blocks]]\nname = \"slab\"\nmaterial = \"rock\"\nfixed = true\n\
-             box = { size = [4.0, 4.0, 1.0], center = [0.0, 0.0, -0.5] }\n\
-             [[blocks]]\nname = \"cube\"\nmaterial = \"rock\"\n\
-             box = { size = [1.0, 1.0, 1.0], center = [0.0, 0.0, 0.5] }\n";
-        let s = crate::scene::parse(text, "cube.toml", "cube").expect("scene parses");
+        let s = crate::scene::parse(crate::solver::CUBE_ON_SLAB, "cube.toml", "cube")
+            .expect("scene parses");
         let mut solver = Solver::new(s.model, s.params);
         for _ in 0..3 {
             solver.step().expect("steps");
         }
-        let inputs = ActivationInputs {
-            params: &solver.params,
-            blocks: &solver.model.blocks,
-            records: &solver.records,
-            step: solver.step,
-            time: solver.time,
-            dt: solver.dt,
-        };
-        let (active, _) = activate(&inputs, &solver.initial_boxes);
+        let active = solver.next_contacts();
         (solver, active)
     }
 

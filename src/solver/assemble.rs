@@ -432,7 +432,6 @@ mod tests {
     use crate::contact::ContactMode;
     use crate::physics::linear::SparseCholesky;
     use crate::solver::Solver;
-    use crate::solver::activate::{ActivationInputs, activate};
 
     /// The rockfall column run into the impact (from 0.25 s on, to the first step where both
     /// vertex–face and edge–edge contacts are active): the solver, its contacts for the next
@@ -444,15 +443,7 @@ mod tests {
         let mut solver = Solver::new(s.model, s.params);
         let mut active = loop {
             solver.step().unwrap();
-            let inputs = ActivationInputs {
-                params: &solver.params,
-                blocks: &solver.model.blocks,
-                records: &solver.records,
-                step: solver.step,
-                time: solver.time,
-                dt: solver.dt,
-            };
-            let (active, _) = activate(&inputs, &solver.initial_boxes);
+            let active = solver.next_contacts();
             let has = |m| active.iter().any(|c| c.cand.mode() == m);
             if solver.time >= 0.25 && has(ContactMode::EdgeEdge) && has(ContactMode::VertexFace) {
                 break active;

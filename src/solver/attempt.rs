@@ -176,12 +176,8 @@ mod tests {
 
     /// A 1 m cube resting on a fixed slab, and the solution moving the cube straight up by `lift`.
     fn cube_lifted(lift: f64) -> (SolverParams, Vec<Block>, Vec<f64>) {
-        let text = "[materials.rock]\ndensity = 2700.0\nyoung_modulus = 2.0e10\npoisson_ratio = 0.25\n\
-             [[blocks]]\nname = \"slab\"\nmaterial = \"rock\"\nfixed = true\n\
-             box = { size = [4.0, 4.0, 1.0], center = [0.0, 0.0, -0.5] }\n\
-             [[blocks]]\nname = \"cube\"\nmaterial = \"rock\"\n\
-             box = { size = [1.0, 1.0, 1.0], center = [0.0, 0.0, 0.5] }\n";
-        let s = crate::scene::parse(text, "cube.toml", "cube").expect("scene parses");
+        let s = crate::scene::parse(crate::solver::CUBE_ON_SLAB, "cube.toml", "cube")
+            .expect("scene parses");
         let mut d = vec![0.0; 24];
         d[12 + 2] = lift;
         (s.params, s.model.blocks, d)

@@ -51,6 +51,14 @@ const PAR_CONTACTS: usize = 2048;
 const PAR_PAIRS: usize = 512;
 const PAR_BLOCKS: usize = 256;
 
+/// A 1 m cube resting on a fixed 4 × 4 × 1 m slab, for unit tests.
+#[cfg(test)]
+const CUBE_ON_SLAB: &str = "[materials.rock]\ndensity = 2700.0\nyoung_modulus = 2.0e10\n\
+    poisson_ratio = 0.25\n[[blocks]]\nname = \"slab\"\nmaterial = \"rock\"\nfixed = true\n\
+    box = { size = [4.0, 4.0, 1.0], center = [0.0, 0.0, -0.5] }\n\
+    [[blocks]]\nname = \"cube\"\nmaterial = \"rock\"\n\
+    box = { size = [1.0, 1.0, 1.0], center = [0.0, 0.0, 0.5] }\n";
+
 use crate::snapshot::{
     BlockSnapshot, ContactSnapshot, EquilibriumReport, RunTotals, Snapshot, StepStats,
 };
@@ -417,6 +425,24 @@ impl Solver {
 
     /// Stage 1: this step's contacts (none between two `held` blocks), and the global matrix
     /// laid out on their pattern.
+    /// What contact activation reads of the state the next step starts from.
+    fn activation_inputs(&self) -> ActivationInputs<'_> {
+        ActivationInputs {
+            params: &self.params,
+            blocks: &self.model.blocks,
+            records: &self.records,
+            step: self.step,
+            time: self.time,
+            dt: self.dt,
+        }
+    }
+
+    /// The contacts the next step would start with, every block awake (for unit tests).
+    #[cfg(test)]
+    fn next_contacts(&self) -> Vec<Active> {
+        activate::activate(&self.activation_inputs(), &self.initial_boxes).0
+    }
+
     fn detect(&mut self, groups: &ContactGroups, held: &[bool]) -> (Vec<Active>, BlockMatrix) {
         // Pairs of two sleeping blocks are neither searched nor in the pattern: they hold no
         // contact this step.
@@ -432,18 +458,7 @@ impl Solver {
                 .collect();
             &awake_near
         };
-        let mut active = activate_awake(
-            &ActivationInputs {
-                params: &self.params,
-                blocks: &self.model.blocks,
-                records: &self.records,
-                step: self.step,
-                time: self.time,
-                dt: self.dt,
-            },
-            groups,
-            near,
-        );
+        let mut active = activate_awake(&self.activation_inputs(), groups, near);
         let pairs = assemble::sparsity_pattern(&active, &self.linear.pattern, near);
         let n = self.model.blocks.len();
         let kmat = match self.linear.matrix.take() {
