@@ -51,6 +51,10 @@ const PAR_CONTACTS: usize = 2048;
 const PAR_PAIRS: usize = 512;
 const PAR_BLOCKS: usize = 256;
 
+use crate::snapshot::{
+    BlockSnapshot, ContactSnapshot, EquilibriumReport, RunTotals, Snapshot, StepStats,
+};
+
 /// A 1 m cube resting on a fixed 4 × 4 × 1 m slab, for unit tests.
 #[cfg(test)]
 const CUBE_ON_SLAB: &str = "[materials.rock]\ndensity = 2700.0\nyoung_modulus = 2.0e10\n\
@@ -58,10 +62,6 @@ const CUBE_ON_SLAB: &str = "[materials.rock]\ndensity = 2700.0\nyoung_modulus = 
     box = { size = [4.0, 4.0, 1.0], center = [0.0, 0.0, -0.5] }\n\
     [[blocks]]\nname = \"cube\"\nmaterial = \"rock\"\n\
     box = { size = [1.0, 1.0, 1.0], center = [0.0, 0.0, 0.5] }\n";
-
-use crate::snapshot::{
-    BlockSnapshot, ContactSnapshot, EquilibriumReport, RunTotals, Snapshot, StepStats,
-};
 
 /// A run that cannot go on.
 #[derive(Debug, Clone, thiserror::Error)]
@@ -423,8 +423,6 @@ impl Solver {
         Ok((dt, solved.settled))
     }
 
-    /// Stage 1: this step's contacts (none between two `held` blocks), and the global matrix
-    /// laid out on their pattern.
     /// What contact activation reads of the state the next step starts from.
     fn activation_inputs(&self) -> ActivationInputs<'_> {
         ActivationInputs {
@@ -443,6 +441,8 @@ impl Solver {
         activate::activate(&self.activation_inputs(), &self.initial_boxes).0
     }
 
+    /// Stage 1: this step's contacts (none between two `held` blocks), and the global matrix
+    /// laid out on their pattern.
     fn detect(&mut self, groups: &ContactGroups, held: &[bool]) -> (Vec<Active>, BlockMatrix) {
         // Pairs of two sleeping blocks are neither searched nor in the pattern: they hold no
         // contact this step.
