@@ -217,6 +217,7 @@ fn activate_one(
         du: Vec3::zeros(),
         lateral: 0.0,
         released: 0.0,
+        face_at_start: None,
     };
     (active, old.is_none())
 }

@@ -4,6 +4,7 @@
 //! [`crate::params::step_rules`].
 
 use super::active::Active;
+use super::counters::debug_log;
 use crate::contact::DetectionParams;
 use crate::contact::groups::{ContactGroups, MAX_BLOCK_PAIRS};
 use crate::model::Block;
@@ -176,6 +177,8 @@ pub(crate) fn check_displacement(
 ) -> Result<(), Retry> {
     let delta = p.max_displacement_ratio;
     let mut r: f64 = 0.0;
+    // The block that moved furthest for its w0, for `DDA3D_DEBUG`.
+    let mut worst = (0, 0.0, 0.0);
     for (i, b) in blocks.iter().enumerate() {
         let di = Vec12::from_column_slice(&d[12 * i..12 * i + 12]);
         let u = b
@@ -188,10 +191,20 @@ pub(crate) fn check_displacement(
         if u > 0.0
             && let Some(w0) = groups.w0_near(i, u)
         {
-            r = r.max(u / (delta * w0));
+            let ratio = u / (delta * w0);
+            if ratio > r {
+                (r, worst) = (ratio, (i, u, w0));
+            }
         }
     }
     if r > p.max_displacement_overshoot {
+        if debug_log() {
+            let (i, u, w0) = worst;
+            eprintln!(
+                "displacement: block {i} moved {u:.3e} m (w0 {w0:.3e} m, volume {:.3e} m3)",
+                blocks[i].mp.volume
+            );
+        }
         return Err(Retry::Displacement(r));
     }
     Ok(())
