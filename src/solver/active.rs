@@ -557,7 +557,7 @@ mod tests {
         let faces: Vec<u32> = c.cand.alternatives.iter().map(|a| a.face).collect();
         // As if a solve had left the vertex deep behind its face: the check moves it.
         c.dn = 1.0;
-        c.reconsider_face(p, &vec![0.0; 24]);
+        c.reconsider_face(p, &[0.0; 24]);
         assert_ne!(
             c.cand.key, key,
             "the failed attempt moved the contact to another face"
