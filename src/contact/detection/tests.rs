@@ -347,9 +347,17 @@ fn opposed_normals_at_one_place_are_one_contact() {
     // Within the deeper one's depth of each other: still one place.
     let near = candidate_at(at + Vec3::new(0.0, 0.05, 0.0), n2, -0.06, 1);
     assert!(opposed(&shallow, &near, &p));
-    // Farther apart than the depth: two places, both kept.
+    // Farther apart than the depth, two places: at 140° still one contact (see the next
+    // test), at 100° both kept.
     let far = candidate_at(at + Vec3::new(0.0, 0.1, 0.0), n2, -0.06, 1);
-    assert!(!opposed(&shallow, &far, &p));
+    assert!(opposed(&shallow, &far, &p));
+    let n_100 = Vec3::new(-0.985, 0.0, -0.174).normalize();
+    let far_100 = candidate_at(at + Vec3::new(0.0, 0.1, 0.0), n_100, -0.06, 1);
+    assert!(!opposed(
+        &candidate_at(at, Vec3::z(), -1e-9, 0),
+        &far_100,
+        &p
+    ));
     // At one place but less than 90° apart (a vertex at a right-angled edge): both kept.
     let square = candidate_at(at, Vec3::x(), -1e-9, 1);
     assert!(!opposed(
@@ -363,4 +371,46 @@ fn opposed_normals_at_one_place_are_one_contact() {
     assert!(!opposed(&up, &at_80, &p));
     let at_100 = candidate_at(at, Vec3::new(-0.985, 0.0, -0.174).normalize(), -1e-9, 1);
     assert!(opposed(&up, &at_100, &p));
+}
+
+/// Two contacts of one pair at two places whose normals, taken toward the same block, are more
+/// than 120° apart are one too (two convex blocks cannot touch so without overlapping), the
+/// normal of a candidate keyed j→i counting reversed; and a vertex–face candidate loses the
+/// alternative faces that would oppose another contact of its pair.
+#[test]
+fn normals_opposed_anywhere_in_a_pair_are_one_contact() {
+    let p = params();
+    let at = Vec3::new(0.0, 0.0, 0.0);
+    let elsewhere = Vec3::new(0.3, 0.2, 0.0);
+    let up = candidate_at(at, Vec3::z(), -1e-9, 0);
+    // A J0/J1 sliver's two sides, 157° apart, 0.36 m from each other.
+    let n_157 = Vec3::new(0.39, 0.0, -0.92).normalize();
+    assert!(opposed(&up, &candidate_at(elsewhere, n_157, -2e-4, 1), &p));
+    // Keyed j→i, its normal points toward j: the same physical normal as `up` is not opposed
+    // (though its raw normal is −z), and one that is opposed toward i is caught.
+    let mut swapped = candidate_at(elsewhere, -Vec3::z(), -1e-9, 1);
+    swapped.key = ContactKey {
+        i: 1,
+        j: 0,
+        mode: 0,
+        feature_i: 1,
+        feature_j: 1,
+    };
+    assert!(!opposed(&up, &swapped, &p));
+    swapped.normal = -n_157;
+    assert!(opposed(&up, &swapped, &p));
+    // Alternatives: the face at 157° goes, the one at 90° stays.
+    let mut vertex = candidate_at(elsewhere, Vec3::x(), -1e-9, 2);
+    vertex.key.mode = 0;
+    let alt = |face: u32, normal: Vec3| Alternative {
+        face,
+        corners: [elsewhere; 3],
+        normal,
+        gap: 0.0,
+    };
+    vertex.alternatives = vec![alt(7, n_157), alt(8, Vec3::y())];
+    let mut kept = vec![up, vertex];
+    drop_opposed_alternatives(0, &mut kept);
+    let faces: Vec<u32> = kept[1].alternatives.iter().map(|a| a.face).collect();
+    assert_eq!(faces, vec![8]);
 }
