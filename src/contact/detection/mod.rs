@@ -422,15 +422,19 @@ fn edge_edge(
 /// threw the neighbour at 30 m/s.
 fn opposed(k: &Candidate, c: &Candidate, p: &DetectionParams) -> bool {
     let reach = p.merge_distance.max(-k.gap).max(-c.gap);
-    let toward_k_i = |x: &Candidate| {
-        if x.key.i == k.key.i {
-            x.normal
-        } else {
-            -x.normal
-        }
-    };
-    toward_k_i(k).dot(&toward_k_i(c)) < OPPOSED_ANYWHERE.cos()
+    let block = k.key.i as usize;
+    let (nk, nc) = (
+        toward(&k.key, &k.normal, block),
+        toward(&c.key, &c.normal, block),
+    );
+    nk.dot(&nc) < OPPOSED_ANYWHERE.cos()
         || k.normal.dot(&c.normal) < 0.0 && (k.xb - c.xb).norm() <= reach
+}
+
+/// A contact's normal `n` (which points toward its block i) taken toward `block`, one of its
+/// two blocks.
+fn toward(key: &ContactKey, n: &Vec3, block: usize) -> Vec3 {
+    if key.i as usize == block { *n } else { -*n }
 }
 
 /// The angle between two contact normals of one block pair (taken toward the same block)
@@ -443,15 +447,14 @@ const OPPOSED_ANYWHERE: f64 = 120.0 * std::f64::consts::PI / 180.0;
 /// opposes another kept candidate's ([`opposed`]): moved to such a face within a step
 /// (`Active::reconsider_face`), the contact would clamp the pair as well.
 fn drop_opposed_alternatives(a: usize, kept: &mut [Candidate]) {
-    let toward_a = |key: &ContactKey, n: &Vec3| if key.i as usize == a { *n } else { -*n };
     let normals: Vec<(ContactKey, Vec3)> = kept
         .iter()
-        .map(|c| (c.key, toward_a(&c.key, &c.normal)))
+        .map(|c| (c.key, toward(&c.key, &c.normal, a)))
         .collect();
     for c in kept.iter_mut().filter(|c| !c.alternatives.is_empty()) {
         let key = c.key;
         c.alternatives.retain(|alt| {
-            let n = toward_a(&key, &alt.normal);
+            let n = toward(&key, &alt.normal, a);
             normals
                 .iter()
                 .all(|(k, m)| *k == key || n.dot(m) >= OPPOSED_ANYWHERE.cos())
