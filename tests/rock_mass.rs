@@ -336,10 +336,11 @@ fn thin_slabs_of_a_closely_spaced_set_slide_without_diverging() {
 
 /// A cube of 2 m cut by three joint sets of random orientation (seed 5 of
 /// `scripts/probe-rock-masses.py`: 230 blocks, two sets steep, one at 34° with 20° friction)
-/// collapses on its base without diverging. A step redone at a shorter Δt kept the face an
-/// open contact had moved to in the failed attempt; a sliver's corner then started 0.55 mm
-/// behind that face's plane, the step pushed it out, and the run stopped at 0.045 s ("vertex
-/// displacement beyond the allowed δ·w0 … at the minimum time step"). Checked here: every
+/// collapses on its base without diverging. Until a step redone at a shorter Δt went back to
+/// the faces its contacts had at the step's start (a failed attempt could move an open contact
+/// to another face, and a sliver's corner then began behind that face's plane), the run
+/// stopped at 0.045 s ("vertex displacement beyond the allowed δ·w0 … at the minimum time
+/// step"). Checked here: every
 /// step solves, no block sinks into the base, and the blocks' kinetic energy stays below the
 /// potential energy they lose.
 #[test]

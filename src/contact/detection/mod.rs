@@ -418,8 +418,8 @@ fn edge_edge(
 /// than [`OPPOSED_ANYWHERE`] apart clamp it as well: two convex blocks whose interiors do not
 /// overlap cannot touch at two places with such normals (the segment between the two points
 /// would run through one of them). In a cube cut by joint sets 23° apart a 130 g sliver held a
-/// 26 kg neighbour by two such contacts, normals 157° apart, 2.6·10⁸ N each, until a step
-/// threw the neighbour at 30 m/s.
+/// 26 kg neighbour by two such contacts, normals 157° apart, 2.6·10⁸ N each, until a solve
+/// moved the neighbour 3.4 mm in 0.1 ms and the run stopped as diverged.
 fn opposed(k: &Candidate, c: &Candidate, p: &DetectionParams) -> bool {
     let reach = p.merge_distance.max(-k.gap).max(-c.gap);
     let block = k.key.i as usize;
