@@ -382,6 +382,55 @@ fn a_cube_of_slabs_on_two_sets_collapses_without_clamping_them() {
     runs_without_diverging("seed 10", &text, 40);
 }
 
+/// A 0.5 m cube cut by three sets (seed 14 of the probe: 91 blocks, DDA-3p) holds fragments of
+/// about a cubic centimetre, 1/400 of its median block, above the default `min_volume`; one of
+/// them, squeezed by its neighbours, moves beyond δ·w0 even at the Δt floor. Where the run
+/// stops so, its message names the block and, as a fragment of the cut, the `min_volume` that
+/// drops it; and with `min_volume` set above it the mass collapses for its 0.2 s.
+#[test]
+fn a_fragment_that_diverges_is_named_and_min_volume_drops_it() {
+    let text = |min_volume: &str| {
+        format!(
+            "[solver]\nmethod = \"penalty\"\nduration = 0.2\n{}[[blocks]]\nname = \"g\"\n\
+             material = \"rock\"\nfixed = true\n\
+             box = {{ size = [2.0, 2.0, 0.25], center = [0, 0, -0.125] }}\n\
+             [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\n{min_volume}\
+             regions = [ {{ box = {{ size = [0.5, 0.5, 0.5], center = [0, 0, 0.25] }} }} ]\n\
+             [[rock_masses.joint_sets]]\nname = \"J0\"\ndip = 84.6\ndip_direction = 97.6\n\
+             spacing = 0.25\nfriction_angle = 20.2\n\
+             [[rock_masses.joint_sets]]\nname = \"J1\"\ndip = 42.0\ndip_direction = 314.2\n\
+             spacing = 0.1\nfriction_angle = 25.8\nspacing_deviation = 0.02\n\
+             [[rock_masses.joint_sets]]\nname = \"J2\"\ndip = 32.2\ndip_direction = 93.7\n\
+             spacing = 0.1\nfriction_angle = 42.2\nspacing_deviation = 0.02\n",
+            ROCK.replace("1.0e10", "1.0e9")
+        )
+    };
+    let s = parse(&text(""));
+    let mut solver = dda3d::solver::Solver::new(s.model, s.params);
+    let mut stopped = None;
+    while !solver.finished() && stopped.is_none() {
+        stopped = solver.step().err().map(|e| e.to_string());
+    }
+    if let Some(e) = stopped {
+        let named = number_after(&e, "min_volume drops when set above ")
+            .unwrap_or_else(|| panic!("the divergence names no fragment: {e}"));
+        assert!(e.contains("by block \"m/"), "{e}");
+        assert!(named < 2e-6, "{named} m³: {e}");
+    }
+    runs_without_diverging(
+        "seed 14, min_volume 2e-6",
+        &text("min_volume = 2.0e-6\n"),
+        80,
+    );
+}
+
+/// The number in `text` right after `before`, if any.
+fn number_after(text: &str, before: &str) -> Option<f64> {
+    let rest = &text[text.find(before)? + before.len()..];
+    let end = rest.find(' ').unwrap_or(rest.len());
+    rest[..end].parse().ok()
+}
+
 /// Runs a rock mass's scene (`label` names it in messages) to its end: more than `min_blocks`
 /// blocks, every step solves, no block sinks into the base (its top at z = 0), and the blocks'
 /// kinetic energy stays below the potential energy they lost. Returns the run's largest

@@ -162,8 +162,8 @@ const RUNAWAY: f64 = 10.0;
 fn runaway(inp: &AttemptInputs, d: &[f64]) -> Result<(), Retry> {
     let p = inp.params;
     match step_control::check_displacement(p, inp.blocks, inp.groups, d) {
-        Err(Retry::Displacement(r)) if r > RUNAWAY * p.max_displacement_overshoot => {
-            Err(Retry::Displacement(r))
+        Err(Retry::Displacement(r, block)) if r > RUNAWAY * p.max_displacement_overshoot => {
+            Err(Retry::Displacement(r, block))
         }
         _ => Ok(()),
     }
@@ -204,7 +204,7 @@ mod tests {
         };
         // The bound: r = 1 at a lift of δ·w0 · overshoot; measure it from the check itself.
         let (_, _, d) = cube_lifted(1.0);
-        let Err(Retry::Displacement(r_per_metre)) =
+        let Err(Retry::Displacement(r_per_metre, _)) =
             step_control::check_displacement(&p, &blocks, &groups, &d)
         else {
             panic!("a lift of 1 m is beyond the bound");

@@ -528,7 +528,7 @@ impl Solver {
                 Err(reason) if at_floor => {
                     return Err(SolverError::Diverged {
                         time: self.time,
-                        reason: reason.divergence(),
+                        reason: reason.divergence(&self.model.blocks),
                     });
                 }
                 Err(reason) => {

@@ -20,8 +20,8 @@ use crate::text::short;
 pub(crate) enum Retry {
     /// The open–close iteration did not converge within its pass limit.
     OpenClose,
-    /// The largest vertex displacement was this many times δ·w0.
-    Displacement(f64),
+    /// The largest vertex displacement was this many times δ·w0, by this block.
+    Displacement(f64, usize),
     /// A closed contact penetrated this many times its contact window d_pen.
     Penetration(f64),
     /// The factorization failed or the solution is not finite.
@@ -32,8 +32,9 @@ pub(crate) enum Retry {
 }
 
 impl Retry {
-    /// The reason a run diverges when this failure happens at the Δt floor.
-    pub fn divergence(&self) -> String {
+    /// The reason a run diverges when this failure happens at the Δt floor (`blocks` name the
+    /// block that moved too far).
+    pub fn divergence(&self, blocks: &[Block]) -> String {
         match self {
             Retry::OpenClose => unreachable!("settled at the floor"),
             Retry::NotFinite => "the solution is not finite".to_string(),
@@ -42,18 +43,7 @@ impl Retry {
                 "a contact penetrated {} times its contact window at the minimum time step",
                 short(*r)
             ),
-            // "Beyond": an overshoot of 1.0004 printed as "1 times" read as none at all. A
-            // small block fast for its size (2 cm at 10 m/s, whose w0 its size caps) reaches
-            // the floor Δt_max/100 this way: the remedy is a smaller Δt_max.
-            Retry::Displacement(r) => format!(
-                "vertex displacement beyond the allowed δ·w0 ({} times) at the minimum time step \
-                 (max_time_step/100); a block this fast for its size needs a smaller max_time_step",
-                if *r < 10.0 {
-                    format!("{r:.4}")
-                } else {
-                    short(*r)
-                }
-            ),
+            Retry::Displacement(r, block) => displacement_divergence(*r, &culprit(blocks, *block)),
         }
     }
 
@@ -61,7 +51,7 @@ impl Retry {
     pub fn describe(&self) -> String {
         match self {
             Retry::OpenClose => "open-close".to_string(),
-            Retry::Displacement(r) => format!("displacement r={r:.2}"),
+            Retry::Displacement(r, _) => format!("displacement r={r:.2}"),
             Retry::Penetration(r) => format!("penetration r={r:.2}"),
             Retry::NotFinite => "not finite".to_string(),
             Retry::EnergyGain(r) => format!("energy gain r={r:.2}"),
@@ -72,11 +62,77 @@ impl Retry {
     /// square root of the excess (a step's displacement grows as Δt²), never below the floor.
     pub fn shortened(&self, dt: f64, floor: f64) -> f64 {
         match self {
-            Retry::Displacement(r) => dt / r.sqrt() * DISPLACEMENT_CUT_SAFETY,
+            Retry::Displacement(r, _) => dt / r.sqrt() * DISPLACEMENT_CUT_SAFETY,
             _ => dt * DT_CUT,
         }
         .max(floor)
     }
+}
+
+/// A rock-mass block smaller than this share of its rock mass's median block is called a
+/// fragment in the message of a run that diverges by its displacement. The divergences of
+/// random jointed cubes (`scripts/probe-rock-masses.py`, seeds 14 and 28) were fragments of
+/// 1/410 and 1/89 of the median (1.1 and 4.0 cm³), squeezed by their neighbours at the Δt
+/// floor; with `min_volume` = 10⁻⁵ m³ neither diverged, and seed 14 ran with 2·10⁻⁶ m³.
+const FRAGMENT_SHARE: f64 = 0.1;
+
+/// What the message of a displacement divergence says of the block that moved too far.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Culprit {
+    pub name: String,
+    pub volume: f64,
+    /// The median block volume of its rock mass, m³ (`None` for a block of its own).
+    pub median: Option<f64>,
+}
+
+/// The block `i` of `blocks` as the divergence message names it.
+pub(crate) fn culprit(blocks: &[Block], i: usize) -> Culprit {
+    let b = &blocks[i];
+    let median = b.rock_mass.map(|of| {
+        let mut v: Vec<f64> = blocks
+            .iter()
+            .filter(|o| o.rock_mass.is_some_and(|m| m.mass == of.mass))
+            .map(|o| o.mp.volume)
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    });
+    Culprit {
+        name: b.name.clone(),
+        volume: b.mp.volume,
+        median,
+    }
+}
+
+/// The reason of a run that diverged because block `c` moved `r` times δ·w0 at the Δt floor,
+/// with the remedies: a smaller Δt_max and, for a fragment of a rock mass, a `min_volume`
+/// that drops it.
+pub(crate) fn displacement_divergence(r: f64, c: &Culprit) -> String {
+    // "Beyond": an overshoot of 1.0004 printed as "1 times" read as none at all. A small block
+    // fast for its size (2 cm at 10 m/s, whose w0 its size caps) reaches the floor Δt_max/100
+    // this way: the remedy is a smaller Δt_max.
+    let times = if r < 10.0 {
+        format!("{r:.4}")
+    } else {
+        short(r)
+    };
+    let mut s = format!(
+        "vertex displacement beyond the allowed δ·w0 ({times} times) at the minimum time step \
+         (max_time_step/100), by block \"{}\" ({} m³); a block this fast for its size needs a \
+         smaller max_time_step",
+        c.name,
+        short(c.volume)
+    );
+    if let Some(median) = c.median.filter(|m| c.volume < FRAGMENT_SHARE * m) {
+        s += &format!(
+            "; it is 1/{} of its rock mass's median block: a fragment of the cut, which the rock \
+             mass's min_volume drops when set above {} m³ (by default blocks under 10⁻³ of the \
+             median are dropped)",
+            short((median / c.volume).round()),
+            short(c.volume)
+        );
+    }
+    s
 }
 
 /// d_n,max = 2 δ w0 of (P22): the largest penetration a step can make, m.
@@ -205,7 +261,7 @@ pub(crate) fn check_displacement(
                 blocks[i].mp.volume
             );
         }
-        return Err(Retry::Displacement(r));
+        return Err(Retry::Displacement(r, worst.0));
     }
     Ok(())
 }
@@ -239,6 +295,70 @@ mod tests {
         );
     }
 
+    /// The message names the block and its volume; a rock-mass block under a tenth of its
+    /// mass's median is called a fragment, with the min_volume that drops it; a block of its
+    /// own, or a rock-mass block near the median, is told only of Δt_max.
+    #[test]
+    fn a_displacement_divergence_names_the_block_and_the_remedy_for_a_fragment() {
+        let block = |volume: f64, median: Option<f64>| Culprit {
+            name: "m/268".into(),
+            volume,
+            median,
+        };
+        let fragment = displacement_divergence(11.93, &block(4.034e-6, Some(3.59e-4)));
+        assert!(fragment.contains("(11.93 times)"), "{fragment}");
+        assert!(
+            fragment.contains("block \"m/268\" (4.034e-6 m³)"),
+            "{fragment}"
+        );
+        assert!(fragment.contains("smaller max_time_step"), "{fragment}");
+        assert!(
+            fragment.contains("1/89 of its rock mass's median"),
+            "{fragment}"
+        );
+        assert!(
+            fragment.contains("min_volume drops when set above 4.034e-6 m³"),
+            "{fragment}"
+        );
+        for (volume, median) in [(4e-5, Some(3.59e-4)), (4e-6, None)] {
+            let m = displacement_divergence(1.0775, &block(volume, median));
+            assert!(
+                m.contains("(1.0775 times)") && m.contains("smaller max_time_step"),
+                "{m}"
+            );
+            assert!(!m.contains("min_volume"), "{m}");
+        }
+    }
+
+    /// A rock mass's median is taken over its own blocks only, not over the other blocks of the
+    /// scene (a base slab, a loose cube): over all four it would be the cube's 1 m³.
+    #[test]
+    fn the_culprit_median_is_its_own_rock_mass() {
+        let s = crate::scene::parse(
+            "[materials.rock]\ndensity = 2600.0\nyoung_modulus = 1.0e10\npoisson_ratio = 0.25\n\
+             [[blocks]]\nname = \"g\"\nmaterial = \"rock\"\nfixed = true\nbox = { size = [40.0, 40.0, 1.0], center = [0, 0, -0.5] }\n\
+             [[blocks]]\nname = \"h\"\nmaterial = \"rock\"\nbox = { size = [1.0, 1.0, 1.0], center = [5, 5, 0.5] }\n\
+             [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\nregions = [ { box = { size = [1.0, 1.0, 1.0], center = [0, 0, 0.5] } } ]\n\
+             [[rock_masses.joint_sets]]\nname = \"J\"\ndip = 0.0\ndip_direction = 0.0\nspacing = 0.5\n",
+            "mass.toml",
+            "mass",
+        )
+        .expect("scene parses");
+        let blocks = &s.model.blocks;
+        let slab = blocks.iter().position(|b| b.name == "g").expect("slab");
+        assert_eq!(culprit(blocks, slab).median, None);
+        let layer = blocks
+            .iter()
+            .position(|b| b.name.starts_with("m/"))
+            .expect("a layer");
+        let c = culprit(blocks, layer);
+        assert!(
+            (c.median.expect("in a rock mass") - 0.5).abs() < 1e-9,
+            "{c:?}"
+        );
+        assert!((c.volume - 0.5).abs() < 1e-9, "{c:?}");
+    }
+
     #[test]
     fn the_first_attempt_lands_on_the_limit_without_a_sliver() {
         assert_eq!(first_attempt(0.01, 1.0), 0.01);
@@ -253,7 +373,7 @@ mod tests {
         let p = SolverParams::default();
         let floor = dt_floor(&p);
         assert!((Retry::OpenClose.shortened(0.01, floor) - 0.003).abs() < 1e-15);
-        let by_4 = Retry::Displacement(4.0).shortened(0.01, floor);
+        let by_4 = Retry::Displacement(4.0, 0).shortened(0.01, floor);
         assert!((by_4 - 0.01 / 2.0 * DISPLACEMENT_CUT_SAFETY).abs() < 1e-15);
         assert_eq!(Retry::NotFinite.shortened(1.5 * floor, floor), floor);
         assert!((next_dt(&p, 0.001, 0.0005, 0) - 0.0013).abs() < 1e-15);
