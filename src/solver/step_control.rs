@@ -331,21 +331,20 @@ mod tests {
     }
 
     /// A rock mass's median is taken over its own blocks only, not over the other blocks of the
-    /// scene (a base slab, a loose cube): over all four it would be the cube's 1 m³.
+    /// scene (the test cube on its slab): over all four it would be the cube's 1 m³.
     #[test]
     fn the_culprit_median_is_its_own_rock_mass() {
-        let s = crate::scene::parse(
-            "[materials.rock]\ndensity = 2600.0\nyoung_modulus = 1.0e10\npoisson_ratio = 0.25\n\
-             [[blocks]]\nname = \"g\"\nmaterial = \"rock\"\nfixed = true\nbox = { size = [40.0, 40.0, 1.0], center = [0, 0, -0.5] }\n\
-             [[blocks]]\nname = \"h\"\nmaterial = \"rock\"\nbox = { size = [1.0, 1.0, 1.0], center = [5, 5, 0.5] }\n\
-             [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\nregions = [ { box = { size = [1.0, 1.0, 1.0], center = [0, 0, 0.5] } } ]\n\
-             [[rock_masses.joint_sets]]\nname = \"J\"\ndip = 0.0\ndip_direction = 0.0\nspacing = 0.5\n",
-            "mass.toml",
-            "mass",
-        )
-        .expect("scene parses");
+        // A 1 m cube beside the test cube on its slab, cut into two layers of 0.5 m³.
+        let text = format!(
+            "{}[[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\n\
+             regions = [ {{ box = {{ size = [1.0, 1.0, 1.0], center = [0, 1.5, 0.5] }} }} ]\n\
+             [[rock_masses.joint_sets]]\nname = \"J\"\ndip = 0.0\ndip_direction = 0.0\n\
+             spacing = 0.5\n",
+            crate::solver::CUBE_ON_SLAB
+        );
+        let s = crate::scene::parse(&text, "mass.toml", "mass").expect("scene parses");
         let blocks = &s.model.blocks;
-        let slab = blocks.iter().position(|b| b.name == "g").expect("slab");
+        let slab = blocks.iter().position(|b| b.name == "slab").expect("slab");
         assert_eq!(culprit(blocks, slab).median, None);
         let layer = blocks
             .iter()
