@@ -345,18 +345,17 @@ fn thin_slabs_of_a_closely_spaced_set_slide_without_diverging() {
 /// potential energy they lose.
 #[test]
 fn a_cube_cut_by_three_random_sets_collapses_without_diverging() {
-    let text = format!(
-        "[solver]\nduration = 0.06\n{}[[blocks]]\nname = \"g\"\nmaterial = \"rock\"\n\
-         fixed = true\nbox = {{ size = [8.0, 8.0, 1.0], center = [0, 0, -0.5] }}\n\
-         [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\n\
-         regions = [ {{ box = {{ size = [2.0, 2.0, 2.0], center = [0, 0, 1.0] }} }} ]\n\
-         [[rock_masses.joint_sets]]\nname = \"J0\"\ndip = 71.6\ndip_direction = 339.3\n\
+    let text = probe_cube(
+        "duration = 0.06\n",
+        1e9,
+        2.0,
+        "",
+        "[[rock_masses.joint_sets]]\nname = \"J0\"\ndip = 71.6\ndip_direction = 339.3\n\
          spacing = 0.4\nfriction_angle = 39.6\nspacing_deviation = 0.08\n\
          [[rock_masses.joint_sets]]\nname = \"J1\"\ndip = 69.8\ndip_direction = 89.7\n\
          spacing = 0.6\nfriction_angle = 12.1\ncohesion = 1000.0\n\
          [[rock_masses.joint_sets]]\nname = \"J2\"\ndip = 34.3\ndip_direction = 36.7\n\
          spacing = 0.2\nfriction_angle = 20.0\n",
-        ROCK.replace("1.0e10", "1.0e9")
     );
     runs_without_diverging("seed 5", &text, 200);
 }
@@ -368,16 +367,15 @@ fn a_cube_cut_by_three_random_sets_collapses_without_diverging() {
 /// at 0.043 s. Checked as above.
 #[test]
 fn a_cube_of_slabs_on_two_sets_collapses_without_clamping_them() {
-    let text = format!(
-        "[solver]\nduration = 0.2\ninitial_equilibrium = true\nequilibrium_max_steps = 30\n\
-         {ROCK}[[blocks]]\nname = \"g\"\nmaterial = \"rock\"\nfixed = true\n\
-         box = {{ size = [2.0, 2.0, 0.25], center = [0, 0, -0.125] }}\n\
-         [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\n\
-         regions = [ {{ box = {{ size = [0.5, 0.5, 0.5], center = [0, 0, 0.25] }} }} ]\n\
-         [[rock_masses.joint_sets]]\nname = \"J0\"\ndip = 52.0\ndip_direction = 74.2\n\
+    let text = probe_cube(
+        "duration = 0.2\ninitial_equilibrium = true\nequilibrium_max_steps = 30\n",
+        1e10,
+        0.5,
+        "",
+        "[[rock_masses.joint_sets]]\nname = \"J0\"\ndip = 52.0\ndip_direction = 74.2\n\
          spacing = 0.15\nfriction_angle = 42.5\n\
          [[rock_masses.joint_sets]]\nname = \"J1\"\ndip = 3.1\ndip_direction = 176.4\n\
-         spacing = 0.05\nfriction_angle = 13.0\n"
+         spacing = 0.05\nfriction_angle = 13.0\n",
     );
     runs_without_diverging("seed 10", &text, 40);
 }
@@ -390,19 +388,17 @@ fn a_cube_of_slabs_on_two_sets_collapses_without_clamping_them() {
 #[test]
 fn a_fragment_that_diverges_is_named_and_min_volume_drops_it() {
     let text = |min_volume: &str| {
-        format!(
-            "[solver]\nmethod = \"penalty\"\nduration = 0.2\n{}[[blocks]]\nname = \"g\"\n\
-             material = \"rock\"\nfixed = true\n\
-             box = {{ size = [2.0, 2.0, 0.25], center = [0, 0, -0.125] }}\n\
-             [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\n{min_volume}\
-             regions = [ {{ box = {{ size = [0.5, 0.5, 0.5], center = [0, 0, 0.25] }} }} ]\n\
-             [[rock_masses.joint_sets]]\nname = \"J0\"\ndip = 84.6\ndip_direction = 97.6\n\
+        probe_cube(
+            "method = \"penalty\"\nduration = 0.2\n",
+            1e9,
+            0.5,
+            min_volume,
+            "[[rock_masses.joint_sets]]\nname = \"J0\"\ndip = 84.6\ndip_direction = 97.6\n\
              spacing = 0.25\nfriction_angle = 20.2\n\
              [[rock_masses.joint_sets]]\nname = \"J1\"\ndip = 42.0\ndip_direction = 314.2\n\
              spacing = 0.1\nfriction_angle = 25.8\nspacing_deviation = 0.02\n\
              [[rock_masses.joint_sets]]\nname = \"J2\"\ndip = 32.2\ndip_direction = 93.7\n\
              spacing = 0.1\nfriction_angle = 42.2\nspacing_deviation = 0.02\n",
-            ROCK.replace("1.0e10", "1.0e9")
         )
     };
     let s = parse(&text(""));
@@ -422,6 +418,24 @@ fn a_fragment_that_diverges_is_named_and_min_volume_drops_it() {
         &text("min_volume = 2.0e-6\n"),
         80,
     );
+}
+
+/// The scene `scripts/probe-rock-masses.py` makes of a seed: a rock mass filling a cube of
+/// `size` m (with the keys `mass_keys` and the joint-set tables `sets`) on a fixed base of
+/// 4 × 4 × ½ its size, the `[solver]` keys `solver`, and the rock of [`ROCK`] with Young's
+/// modulus `young`, Pa.
+fn probe_cube(solver: &str, young: f64, size: f64, mass_keys: &str, sets: &str) -> String {
+    let base = [4.0 * size, 4.0 * size, size / 2.0];
+    format!(
+        "[solver]\n{solver}{}[[blocks]]\nname = \"g\"\nmaterial = \"rock\"\nfixed = true\n\
+         box = {{ size = {base:?}, center = [0, 0, {:?}] }}\n\
+         [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\n{mass_keys}\
+         regions = [ {{ box = {{ size = {:?}, center = [0, 0, {:?}] }} }} ]\n{sets}",
+        ROCK.replace("1.0e10", &format!("{young:e}")),
+        -size / 4.0,
+        [size; 3],
+        size / 2.0,
+    )
 }
 
 /// The number in `text` right after `before`, if any.
