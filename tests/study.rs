@@ -335,6 +335,12 @@ fn bad_study_files_are_one_line_and_exit_2() {
             format!("scene = {sliding:?}\n{head}watch = [\"column*\"]\n{ok_param}"),
             "watch: \"column*\" matches no free block",
         ),
+        // A device that never ends is read only up to a scene file's limit (it filled the
+        // memory before).
+        (
+            format!("scene = \"/dev/zero\"\n{head}{ok_param}"),
+            "scene: the input goes on, more than the limit of 16 MiB for a scene file",
+        ),
     ];
     for (k, (text, want)) in cases.iter().enumerate() {
         let file = dir.join(format!("bad{k}.toml"));
@@ -351,6 +357,23 @@ fn bad_study_files_are_one_line_and_exit_2() {
             "nothing written for bad input"
         );
     }
+}
+
+/// A study file that never ends (`/dev/zero`) is read up to the scene files' limit, then
+/// refused in one line; it used to be read until memory ran out.
+#[test]
+fn an_endless_study_file_is_refused_at_the_limit() {
+    let dir = tmp("endless");
+    let o = study(&["--quiet"], Path::new("/dev/zero"), &dir.join("out"));
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains(
+            "/dev/zero: the input goes on, more than the limit of 16 MiB for a study file"
+        ),
+        "{err}"
+    );
 }
 
 /// The sliding block's largest displacement follows s = ½ g (sin θ − cos θ tan φ) t² on the

@@ -141,7 +141,7 @@ fn read_text(path: &Path) -> Result<(String, String, String), SceneError> {
         line,
         message,
     };
-    let bytes = read_bounded(path).map_err(|m| err(None, m))?;
+    let bytes = read_bounded(path, "a scene file").map_err(|m| err(None, m))?;
     let text = String::from_utf8(bytes).map_err(|e| {
         let bytes = e.as_bytes();
         let bad = e.utf8_error().valid_up_to();
@@ -166,13 +166,14 @@ fn read_text(path: &Path) -> Result<(String, String, String), SceneError> {
 }
 
 /// The file's bytes, at most [`MAX_FILE_BYTES`] of them. A regular file says its size up front;
-/// a device, pipe or terminal (`/dev/zero`) does not, and is read up to the limit.
-fn read_bounded(path: &Path) -> Result<Vec<u8>, String> {
+/// a device, pipe or terminal (`/dev/zero`) does not, and is read up to the limit. `kind` names
+/// the file in the message ("a scene file").
+pub(crate) fn read_bounded(path: &Path, kind: &str) -> Result<Vec<u8>, String> {
     let cannot = |e: std::io::Error| format!("cannot read: {e}");
     let file = std::fs::File::open(path).map_err(cannot)?;
     let too_large = |size: &str| {
         format!(
-            "{size}, more than the limit of {} MiB for a scene file",
+            "{size}, more than the limit of {} MiB for {kind}",
             MAX_FILE_BYTES >> 20
         )
     };

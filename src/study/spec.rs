@@ -113,15 +113,29 @@ fn fingerprint(texts: &[&str]) -> String {
     format!("{h:016x}")
 }
 
-fn read(path: &Path) -> Result<String, String> {
-    std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))
+/// A study's or its scene's text, read no further than a scene file may be (`study /dev/zero`
+/// read until memory ran out).
+fn read(path: &Path, kind: &str) -> Result<String, String> {
+    let shown = path.display();
+    let bytes = crate::scene::read_bounded(path, kind).map_err(|e| {
+        match e.strip_prefix("cannot read: ") {
+            Some(why) => format!("cannot read {shown}: {why}"),
+            None => e,
+        }
+    })?;
+    String::from_utf8(bytes).map_err(|e| {
+        format!(
+            "not UTF-8 text (byte {} of the file)",
+            e.utf8_error().valid_up_to() + 1
+        )
+    })
 }
 
 /// Reads and checks a study file and its base scene.
 pub(super) fn load(path: &Path) -> Result<Study, StudyError> {
     let shown = path.display().to_string();
     let fail = |m: String| StudyError::input(format!("{shown}: {m}"));
-    let text = read(path).map_err(fail)?;
+    let text = read(path, "a study file").map_err(fail)?;
     let file: StudyFile = toml::from_str(&text).map_err(|e| {
         let line = e
             .span()
@@ -133,7 +147,7 @@ pub(super) fn load(path: &Path) -> Result<Study, StudyError> {
         ))
     })?;
     let scene_path = path.parent().unwrap_or(Path::new("")).join(&file.scene);
-    let scene_text = read(&scene_path).map_err(|e| fail(format!("scene: {e}")))?;
+    let scene_text = read(&scene_path, "a scene file").map_err(|e| fail(format!("scene: {e}")))?;
     let default_name = scene_path
         .file_stem()
         .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
