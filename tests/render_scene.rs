@@ -147,3 +147,128 @@ fn render_without_an_adapter_is_an_input_error() {
     assert!(err.contains("mesa-vulkan-drivers"), "{err}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
+
+fn os(s: &str) -> &std::ffi::OsStr {
+    std::ffi::OsStr::new(s)
+}
+
+fn dda3d<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// `render --resume`: the frames start from a checkpoint of `run` (a large rock mass's
+/// equilibrium stage computed once): the first frame is the checkpoint's state at its time and
+/// step, the next ones fall on the multiples of 1/fps after it, up to the new end time.
+#[test]
+fn render_resumes_from_a_checkpoint() {
+    let tmp = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_resume");
+    let _ = std::fs::remove_dir_all(&tmp);
+    let scene =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rock_column_rockfall.toml");
+    let run = tmp.join("run");
+    let o = dda3d(&[
+        os("run"),
+        scene.as_os_str(),
+        os("--duration"),
+        os("0.6"),
+        os("--checkpoint-every"),
+        os("0.5"),
+        os("-q"),
+        os("--out"),
+        run.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ckpt = std::fs::read_dir(&run)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "ckpt"))
+        .expect("a checkpoint");
+    let t0: f64 = ckpt.file_stem().unwrap().to_str().unwrap()["checkpoint_".len()..]
+        .parse()
+        .unwrap();
+    assert!((0.5..0.6).contains(&t0), "{t0}");
+
+    // Bad uses need no GPU: an end before the checkpoint, a solver flag (the checkpoint's
+    // settings hold), a file that is not a checkpoint. One line each, exit 2.
+    let frames = tmp.join("frames");
+    let bad: [(&[&str], &str); 3] = [
+        (&["--duration", "0.3"], "give a later --duration"),
+        (&["--method", "penalty"], "cannot be used with"),
+        (&["--fps", "0"], "--fps must be positive"),
+    ];
+    for (extra, want) in bad {
+        let mut args = vec![os("render"), os("--resume"), ckpt.as_os_str()];
+        args.extend(extra.iter().map(|a| os(a)));
+        args.extend([os("--out"), frames.as_os_str()]);
+        let o = dda3d(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(want), "{extra:?}: {err}");
+        assert!(!frames.exists(), "{extra:?}: nothing written");
+    }
+    let not_one = run.join("summary.json");
+    let o = dda3d(&[
+        os("render"),
+        os("--resume"),
+        not_one.as_os_str(),
+        os("--out"),
+        frames.as_os_str(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("summary.json: not a dda3d checkpoint"),
+        "{err}"
+    );
+
+    if gpu_or_skip("render_resumes_from_a_checkpoint").is_none() {
+        return;
+    }
+    let o = dda3d(&[
+        os("render"),
+        os("--resume"),
+        ckpt.as_os_str(),
+        os("--duration"),
+        os("0.8"),
+        os("--fps"),
+        os("10"),
+        os("--width"),
+        os("320"),
+        os("--height"),
+        os("180"),
+        os("--msaa"),
+        os("1"),
+        os("--quiet"),
+        os("--out"),
+        frames.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(frames.join("frames.csv")).unwrap();
+    let rows: Vec<Vec<String>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    let times: Vec<f64> = rows.iter().map(|r| r[1].parse().unwrap()).collect();
+    let steps: Vec<u64> = rows.iter().map(|r| r[2].parse().unwrap()).collect();
+    assert_eq!(
+        times.len(),
+        4,
+        "the checkpoint's state, then 0.6, 0.7, 0.8: {times:?}"
+    );
+    assert!((times[0] - t0).abs() < 1e-6, "{} against {t0}", times[0]);
+    for (k, want) in [0.6, 0.7, 0.8].into_iter().enumerate() {
+        assert!((times[k + 1] - want).abs() < 1e-9, "{times:?}");
+    }
+    // The step count goes on from the checkpoint's (the run's 0.5 s took tens of steps).
+    assert!(steps[0] > 20, "{steps:?}");
+    assert!(steps.windows(2).all(|w| w[0] < w[1]), "{steps:?}");
+    for r in &rows {
+        let img = image::open(frames.join(&r[3])).unwrap();
+        assert_eq!((img.width(), img.height()), (320, 180));
+    }
+}

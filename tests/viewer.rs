@@ -163,3 +163,103 @@ fn bad_options_are_rejected_before_opening_a_window() {
         assert_eq!(out.status.code(), Some(2), "{extra:?}");
     }
 }
+
+/// `view --resume CHECKPOINT`: the window opens at a checkpoint of `run` (a large rock mass's
+/// equilibrium stage computed once, headless); bad uses are one line and exit 2 before any
+/// window opens.
+#[test]
+fn the_viewer_opens_at_a_checkpoint() {
+    let dir = tmp("resume");
+    let run = dir.join("run");
+    let o = bin()
+        .arg("run")
+        .arg(scene("rock_column_rockfall.toml"))
+        .args([
+            "--duration",
+            "0.6",
+            "--checkpoint-every",
+            "0.5",
+            "-q",
+            "--out",
+        ])
+        .arg(&run)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ckpt = std::fs::read_dir(&run)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "ckpt"))
+        .expect("a checkpoint");
+    let t0: f64 = ckpt.file_stem().unwrap().to_str().unwrap()["checkpoint_".len()..]
+        .parse()
+        .unwrap();
+
+    let summary = run.join("summary.json");
+    let stable = scene("slope_stable.toml");
+    let bad: [(Vec<&std::ffi::OsStr>, &str); 4] = [
+        (
+            vec![ckpt.as_ref(), "--method".as_ref(), "penalty".as_ref()],
+            "cannot be used with",
+        ),
+        (
+            vec![ckpt.as_ref(), "--duration".as_ref(), "0.2".as_ref()],
+            "give a later --duration",
+        ),
+        (
+            vec![summary.as_ref()],
+            "summary.json: not a dda3d checkpoint",
+        ),
+        (vec![ckpt.as_ref(), stable.as_ref()], "cannot be used with"),
+    ];
+    for (extra, want) in bad {
+        let out = bin()
+            .args(["view", "--resume"])
+            .args(&extra)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{extra:?}: {err}");
+        assert!(err.contains(want), "{extra:?}: {err}");
+    }
+
+    if !have_xvfb_run() {
+        skip_or_fail(
+            "viewer at a checkpoint",
+            "xvfb-run is not installed (Debian: apt-get install xvfb xauth)",
+        );
+        return;
+    }
+    let runtime = dir.join("xdg");
+    std::fs::create_dir_all(&runtime).unwrap();
+    let png = dir.join("window.png");
+    let child = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1600x900x24"])
+        .arg(env!("CARGO_BIN_EXE_dda3d"))
+        .args(["view", "--resume"])
+        .arg(&ckpt)
+        .args(["--paused", "--exit-after-frames", "10"])
+        .arg("--screenshot")
+        .arg(&png)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .env("XDG_RUNTIME_DIR", &runtime)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start xvfb-run");
+    let (status, stderr) = finish(child);
+    if !status.success() && stderr.contains("no GPU adapter") {
+        skip_or_fail("viewer at a checkpoint", "no GPU adapter");
+        return;
+    }
+    assert!(status.success(), "viewer failed ({status}):\n{stderr}");
+    assert!(png.exists(), "no screenshot written; stderr:\n{stderr}");
+    // The window opened at the checkpoint's time (src/viewer/sim has the run going on from
+    // there, and Reset going back to it).
+    assert!(t0 > 0.5 && t0 < 0.6, "{t0}");
+    assert!(stderr.contains(&format!("to t = {t0:.3} s")), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -19,13 +19,27 @@ use crate::text::short;
 
 #[derive(Args, Debug)]
 pub struct RenderArgs {
-    /// Scene file (TOML).
-    pub scene: PathBuf,
-    /// Output directory for frame_00000.png …, frames.csv (default: out/<scene name>/frames).
+    /// Scene file (TOML). Left out with --resume, whose checkpoint holds the scene.
+    #[arg(required_unless_present = "resume")]
+    pub scene: Option<PathBuf>,
+    /// Output directory for frame_00000.png …, frames.csv (default: out/<scene name>/frames,
+    /// and out/<scene name>-resumed/frames with --resume).
     #[arg(long)]
     pub out: Option<PathBuf>,
     #[command(flatten)]
     pub overrides: SolverOverrides,
+    /// Render from the state saved in CHECKPOINT (a checkpoint_<t>.ckpt file of `run
+    /// --checkpoint-every` or the viewer's Save state), in place of SCENE: a large rock mass's
+    /// equilibrium stage is then computed once, not for every render. The first frame is the
+    /// checkpoint's state at its time t, the next ones fall on the multiples of 1/fps after it;
+    /// the solver settings are the checkpoint's, and --duration is the new end time (from
+    /// t = 0, as in the scene).
+    #[arg(
+        long,
+        value_name = "CHECKPOINT",
+        conflicts_with_all = ["scene", "method", "mode", "spectral_radius", "max_time_step", "initial_equilibrium", "sleep_velocity", "compare", "compare_set"]
+    )]
+    pub resume: Option<PathBuf>,
     /// Frames per second of simulated time.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub fps: f64,
@@ -79,6 +93,14 @@ pub struct RenderArgs {
     /// --compare.
     #[arg(long, value_name = "KEY=VALUE,...")]
     pub compare_set: Option<String>,
+}
+
+impl RenderArgs {
+    /// The file the render comes from, for messages: the scene, or the checkpoint resumed.
+    pub(super) fn source(&self) -> &Path {
+        let from = self.resume.as_deref().or(self.scene.as_deref());
+        from.unwrap_or(Path::new("-"))
+    }
 }
 
 /// What the simulation side of a render did.
@@ -139,21 +161,34 @@ pub(super) fn capture_failure(out: &Path, e: RenderError) -> Failure {
 /// land exactly on the frame times, not from re-simulation. SIGINT or SIGTERM ends the
 /// simulation after its step; the frames already handed over are still written.
 pub(super) fn execute(args: &RenderArgs) -> Result<(), Failure> {
-    let scene = load_scene(&args.scene, &args.overrides)?;
-    check_image_options(args)?;
-    check_frame_count(scene.params.duration, args.fps)?;
-    if let Some(spec) = CompareSpec::parse(args.compare.as_deref(), args.compare_set.as_deref())
-        .map_err(|e| Failure::Input(e.to_string()))?
-    {
-        return super::render_compare::execute(args, scene, &spec);
-    }
+    let (mut solver, default_out) = match &args.resume {
+        Some(path) => {
+            let solver = super::resume::resume(path, &args.overrides)?;
+            check_image_options(args)?;
+            let out = super::resume::default_out(&solver);
+            (solver, out)
+        }
+        None => {
+            let scene = load_scene(args.source(), &args.overrides)?;
+            check_image_options(args)?;
+            if let Some(spec) =
+                CompareSpec::parse(args.compare.as_deref(), args.compare_set.as_deref())
+                    .map_err(|e| Failure::Input(e.to_string()))?
+            {
+                check_frame_count(scene.params.duration, args.fps)?;
+                return super::render_compare::execute(args, scene, &spec);
+            }
+            let out = PathBuf::from("out").join(slug(&scene.name));
+            (Solver::new(scene.model, scene.params), out)
+        }
+    };
+    check_frame_count(solver.params.duration - solver.time, args.fps)?;
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)).join("frames"));
+        .unwrap_or_else(|| default_out.join("frames"));
     let opts = capture_options(args, &out)?;
-    let name = scene.name.clone();
-    let mut solver = Solver::new(scene.model, scene.params);
+    let name = solver.model.name.clone();
     exit::catch_stop_signals()?;
     let capture = FrameCapture::start(opts).map_err(|e| capture_failure(&out, e))?;
     let start = Instant::now();
@@ -193,7 +228,7 @@ pub(super) fn conclude(
     if let Some(e) = &simulated.failure {
         return Err(Failure::Diverged(format!(
             "{}: {e}; {reached}",
-            args.scene.display()
+            args.source().display()
         )));
     }
     if let Some(signal) = simulated.interrupted {
@@ -319,9 +354,10 @@ pub(super) fn capture_options(args: &RenderArgs, out: &Path) -> Result<CaptureOp
     Ok(opts)
 }
 
-/// Steps the solver to each frame time in turn and submits a snapshot there, frame 0 included.
-/// A solver failure ends the run early and is returned in [`Simulated::failure`]; a capture
-/// failure is the error.
+/// Steps the solver to each frame time in turn and submits a snapshot there, the first frame
+/// being the solver's state as it is (t = 0, or a resumed checkpoint's time), the others at the
+/// multiples of 1/fps after it. A solver failure ends the run early and is returned in
+/// [`Simulated::failure`]; a capture failure is the error.
 fn simulate_frames(
     solver: &mut Solver,
     capture: &FrameCapture,
@@ -329,10 +365,10 @@ fn simulate_frames(
 ) -> Result<Simulated, RenderError> {
     let mut simulated = Simulated::new();
     let frame_dt = 1.0 / args.fps;
-    let total_frames = (solver.params.duration * args.fps + 1e-9).floor() as u64 + 1;
+    let (first, last) = frame_numbers(solver.time, solver.params.duration, args.fps);
     let mut progress = Progress::new(solver.params.duration, args.quiet);
     capture.submit(solver.snapshot())?;
-    for k in 1..total_frames {
+    for k in first..=last {
         if !simulated.step_to(solver, k as f64 * frame_dt, frame_dt) {
             break;
         }
@@ -341,6 +377,15 @@ fn simulate_frames(
     }
     progress.finish();
     Ok(simulated)
+}
+
+/// The numbers k of the frames after the first, at k/fps, from a start at `t0` to the end at
+/// `duration` (both within round-off of a frame time count as on it): 1..=⌊duration·fps⌋ from
+/// t = 0.
+fn frame_numbers(t0: f64, duration: f64, fps: f64) -> (u64, u64) {
+    let first = (t0 * fps + 1e-9).floor() as u64 + 1;
+    let last = (duration * fps + 1e-9).floor() as u64;
+    (first, last)
 }
 
 /// Writes render_summary.json (atomically): frame count, size, adapter, where the time went,
@@ -413,5 +458,23 @@ mod tests {
             ArrowMode::None
         );
         assert!(options(&["--normals", "--no-arrows"]).is_err());
+    }
+
+    /// From t = 0 the frames after the first are 1..=⌊duration·fps⌋, as before `--resume`;
+    /// from a checkpoint they are the multiples of 1/fps after its time, one on a frame time
+    /// (within round-off) included in the first frame.
+    #[test]
+    fn frames_follow_the_multiples_of_one_over_fps_after_the_start() {
+        assert_eq!(frame_numbers(0.0, 2.0, 30.0), (1, 60));
+        assert_eq!(frame_numbers(0.0, 0.05, 30.0), (1, 1));
+        assert_eq!(
+            frame_numbers(0.0, 0.01, 30.0),
+            (1, 0),
+            "no frame after the first"
+        );
+        assert_eq!(frame_numbers(0.5, 2.0, 30.0), (16, 60));
+        assert_eq!(frame_numbers(0.5 - 1e-13, 2.0, 30.0), (16, 60));
+        assert_eq!(frame_numbers(0.51, 2.0, 30.0), (16, 60));
+        assert_eq!(frame_numbers(0.01, 0.1, 10.0), (1, 1));
     }
 }

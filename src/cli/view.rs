@@ -1,22 +1,36 @@
 //! `dda3d view` (and its shorthand `dda3d SCENE.toml`): reads the viewer's flags, loads the
 //! scene, and opens the viewer of [`crate::viewer`] with them.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use clap::Args;
 
 use super::{CliError, SolverOverrides, load_scene};
 use crate::compare::CompareSpec;
 use crate::output::slug;
-use crate::viewer::sim::Speed;
+use crate::scene::{OutputSettings, Scene};
+use crate::solver::checkpoint;
+use crate::viewer::sim::{Origin, Speed};
 use crate::viewer::{ViewerError, ViewerOptions, run_viewer};
 
 #[derive(Args, Debug, Clone)]
 pub struct ViewArgs {
-    /// Scene file (TOML).
-    pub scene: PathBuf,
+    /// Scene file (TOML). Left out with --resume, whose checkpoint holds the scene.
+    #[arg(required_unless_present = "resume")]
+    pub scene: Option<PathBuf>,
     #[command(flatten)]
     pub overrides: SolverOverrides,
+    /// Open at the state saved in CHECKPOINT (a checkpoint_<t>.ckpt file of `run
+    /// --checkpoint-every` or of Save state), in place of SCENE: a large rock mass's
+    /// equilibrium stage is computed once, headless, and watched from there as often as
+    /// wanted. Reset goes back to it. The solver settings are the checkpoint's; --duration is
+    /// the end time (from t = 0, as in the scene).
+    #[arg(
+        long,
+        value_name = "CHECKPOINT",
+        conflicts_with_all = ["scene", "method", "mode", "spectral_radius", "max_time_step", "initial_equilibrium", "sleep_velocity"]
+    )]
+    pub resume: Option<PathBuf>,
     /// Initial window size in pixels, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
@@ -103,9 +117,27 @@ impl From<ViewerError> for CliError {
     }
 }
 
+/// The scene the viewer opens, and the checkpoint it starts from (encoded) with `--resume`: the
+/// checkpoint's blocks, settings and name then make the scene.
+fn open(args: &ViewArgs) -> Result<(Scene, Option<Origin>), CliError> {
+    let Some(path) = &args.resume else {
+        let scene = args.scene.as_deref().unwrap_or(Path::new("-"));
+        return Ok((load_scene(scene, &args.overrides)?, None));
+    };
+    let solver = super::resume::resume(path, &args.overrides).map_err(CliError::from)?;
+    let scene = Scene {
+        name: solver.model.name.clone(),
+        params: solver.params.clone(),
+        model: solver.model.clone(),
+        rock_masses: Vec::new(),
+        output: OutputSettings::default(),
+    };
+    Ok((scene, Some(checkpoint::encode(&solver).into())))
+}
+
 /// `dda3d view`.
 pub fn view(args: &ViewArgs) -> Result<(), CliError> {
-    let scene = load_scene(&args.scene, &args.overrides)?;
+    let (scene, origin) = open(args)?;
     // Checked as `run --compare` checks it: one line naming the flag and the key, exit 2.
     let compare = CompareSpec::parse(args.compare.as_deref(), args.compare_set.as_deref())
         .and_then(|spec| spec.map(|s| s.derive(&scene.params)).transpose())
@@ -167,6 +199,7 @@ pub fn view(args: &ViewArgs) -> Result<(), CliError> {
         ghost: args.ghost,
         compare,
         selected,
+        origin,
     })?;
     Ok(())
 }

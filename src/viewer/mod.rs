@@ -51,6 +51,9 @@ pub struct ViewerOptions {
     pub ghost: bool,
     /// The block selected at start (`--select`).
     pub selected: Option<usize>,
+    /// `--resume`: the checkpoint (encoded) the run starts from and Reset goes back to, of
+    /// `scene`'s blocks; `None`: the scene at t = 0.
+    pub origin: Option<sim::Origin>,
 }
 
 /// Why the viewer could not run or stopped, as one line.

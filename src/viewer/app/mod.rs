@@ -194,9 +194,10 @@ struct Viewer {
     clock: FrameClock,
     /// The last composed picture, on software rasterizers (see `frame_cache.rs`).
     frame_cache: Option<FrameCache>,
-    /// The scene as loaded and the event loop's waker: a comparison started or ended from the
-    /// panel restarts the simulation threads from them.
+    /// The scene as loaded, the checkpoint resumed (if any) and the event loop's waker: a
+    /// comparison started or ended from the panel restarts the simulation threads from them.
     scene: crate::scene::Scene,
+    origin: Option<crate::viewer::sim::Origin>,
     proxy: EventLoopProxy<Wake>,
 }
 
@@ -245,6 +246,7 @@ impl Viewer {
             clock: FrameClock::new(opts.exit_after_frames, software),
             frame_cache,
             scene: opts.scene,
+            origin: opts.origin,
             proxy,
         })
     }
@@ -380,7 +382,7 @@ impl Viewer {
     }
 
     /// Starts a comparison with run B's settings `b`, or ends it (`None`): the simulation
-    /// restarts from t = 0, paused, with run A's present settings.
+    /// restarts from t = 0 (or the checkpoint resumed), paused, with run A's present settings.
     fn set_compare(&mut self, b: Option<crate::params::SolverParams>) {
         let mut scene = self.scene.clone();
         if let Some(f) = self.ui.frame.as_ref() {
@@ -398,6 +400,7 @@ impl Viewer {
             compare: b,
             ghost: false,
             selected: self.ui.selected,
+            origin: self.origin.clone(),
         };
         let sim = match SimLink::start(&opts, self.proxy.clone()) {
             Ok(sim) => sim,

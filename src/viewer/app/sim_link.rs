@@ -43,6 +43,7 @@ impl SimLink {
                 handle: SimHandle::spawn(
                     scene.model.clone(),
                     scene.params.clone(),
+                    opts.origin.clone(),
                     opts.speed,
                     opts.play,
                     Box::new(waker),
@@ -54,8 +55,8 @@ impl SimLink {
                 pair: Box::new(
                     SimPair::spawn(
                         scene.model.clone(),
-                        scene.params.clone(),
-                        b.clone(),
+                        (scene.params.clone(), b.clone()),
+                        opts.origin.clone(),
                         opts.speed,
                         opts.play,
                         waker,

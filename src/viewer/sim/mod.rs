@@ -37,6 +37,10 @@ use crate::params::SolverParams;
 
 pub use protocol::{Command, Frame, RunState, Speed, StepRecord};
 
+/// A checkpoint (`crate::solver::checkpoint`, encoded) that a run starts from and Reset goes
+/// back to: `view --resume`.
+pub type Origin = Arc<[u8]>;
+
 /// What the sim thread leaves for the window.
 #[derive(Default)]
 struct Mailbox {
@@ -56,19 +60,31 @@ pub struct SimHandle {
 }
 
 impl SimHandle {
-    /// Starts the thread on `model` with `params` (`params.duration` is the scene's end time).
-    /// `waker` is called (from the sim thread) when a new frame is waiting; the window uses it to
-    /// schedule a redraw. The first frame (t = 0) is published before this returns.
+    /// Starts the thread on `model` with `params` (`params.duration` is the scene's end time), or
+    /// from the checkpoint `origin` (`view --resume`: encoded, of `model`'s blocks, `params`
+    /// its settings), which Reset then goes back to. `waker` is called (from the sim thread)
+    /// when a new frame is waiting; the window uses it to schedule a redraw. The first frame
+    /// (t = 0, or the checkpoint's time) is published before this returns.
     pub fn spawn(
         model: Model,
         params: SolverParams,
+        origin: Option<Origin>,
         speed: Speed,
         play: bool,
         waker: Box<dyn Fn() + Send>,
     ) -> std::io::Result<SimHandle> {
         let (tx, rx) = mpsc::channel();
         let mailbox = Arc::new(Mutex::new(Mailbox::default()));
-        let thread = thread::start(model, params, speed, play, mailbox.clone(), waker, rx)?;
+        let thread = thread::start(
+            model,
+            params,
+            origin,
+            speed,
+            play,
+            mailbox.clone(),
+            waker,
+            rx,
+        )?;
         Ok(SimHandle {
             tx,
             mailbox,
@@ -168,7 +184,7 @@ mod tests {
 
     fn spawn(speed: Speed, play: bool) -> SimHandle {
         let s = rockfall();
-        SimHandle::spawn(s.model, s.params, speed, play, Box::new(|| {})).unwrap()
+        SimHandle::spawn(s.model, s.params, None, speed, play, Box::new(|| {})).unwrap()
     }
 
     const WAIT: Duration = Duration::from_secs(30);
@@ -299,6 +315,49 @@ mod tests {
         assert_eq!(f.state, RunState::Paused);
     }
 
+    /// `view --resume`: a run started from a checkpoint opens at its time and step, its next
+    /// step is the one the checkpoint's solver takes, and Reset goes back to it, not to t = 0.
+    #[test]
+    fn a_run_from_a_checkpoint_starts_and_resets_there() {
+        use crate::solver::{Solver, checkpoint};
+        let s = rockfall();
+        let mut solver = Solver::new(s.model.clone(), s.params.clone());
+        for _ in 0..20 {
+            solver.step().unwrap();
+        }
+        let origin: Origin = checkpoint::encode(&solver).into();
+        let at = solver.snapshot();
+        solver.step().unwrap();
+        let next = solver.snapshot();
+        let params = solver.params.clone();
+        let mut h = SimHandle::spawn(
+            s.model,
+            params,
+            Some(origin),
+            Speed::Max,
+            false,
+            Box::new(|| {}),
+        )
+        .unwrap();
+        let first = h.latest().expect("a frame at start");
+        assert_eq!((first.snapshot.time, first.snapshot.step), (at.time, 20));
+        assert_eq!(first.snapshot.blocks[1].vertices, at.blocks[1].vertices);
+
+        let id = h.send(Command::Step);
+        let f = h.wait_for(WAIT, |f| f.applied >= id && f.snapshot.step == 21);
+        let f = f.expect("one step");
+        assert_eq!(f.snapshot.time.to_bits(), next.time.to_bits());
+        for (a, b) in f.snapshot.blocks.iter().zip(&next.blocks) {
+            assert_eq!(a.vertices, b.vertices, "{}", a.name);
+        }
+
+        let id = h.send(Command::Reset);
+        let f = h.wait_for(WAIT, |f| f.applied >= id).unwrap();
+        assert_eq!((f.snapshot.time, f.snapshot.step), (at.time, 20));
+        assert_eq!(f.snapshot.blocks[1].vertices, at.blocks[1].vertices);
+        assert_eq!(f.generation, 1);
+    }
+
     #[test]
     fn runs_to_the_end_then_play_continues() {
         let mut h = spawn(Speed::Max, false);
@@ -371,6 +430,7 @@ mod tests {
         let mut h = SimHandle::spawn(
             s.model,
             s.params,
+            None,
             Speed::Max,
             false,
             Box::new(move || {

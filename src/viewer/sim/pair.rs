@@ -15,7 +15,7 @@
 use std::sync::Arc;
 use std::time::Duration;
 
-use super::{Command, Frame, RunState, SimHandle, Speed, StepRecord};
+use super::{Command, Frame, Origin, RunState, SimHandle, Speed, StepRecord};
 use crate::model::Model;
 use crate::params::SolverParams;
 
@@ -57,6 +57,8 @@ enum Mode {
 pub struct SimPair {
     pub a: SimHandle,
     pub b: SimHandle,
+    /// Where both runs start, and Reset takes them back to: t = 0, or a checkpoint's time.
+    start: f64,
     /// The limit both were last given.
     target: f64,
     mode: Mode,
@@ -68,27 +70,31 @@ pub struct SimPair {
 }
 
 impl SimPair {
-    /// Starts both threads (paused, limited to t = 0), then plays both if `play`.
+    /// Starts both threads (paused, limited to their start: t = 0, or the time of the
+    /// checkpoint `origin` both start from), then plays both if `play`.
     pub fn spawn(
         model: Model,
-        params_a: SolverParams,
-        params_b: SolverParams,
+        (params_a, params_b): (SolverParams, SolverParams),
+        origin: Option<Origin>,
         speed: Speed,
         play: bool,
         waker: impl Fn() + Send + Clone + 'static,
     ) -> std::io::Result<SimPair> {
         let spawn = |p: SolverParams| {
-            let mut h = SimHandle::spawn(model.clone(), p, speed, false, Box::new(waker.clone()))?;
-            h.send(Command::SetLimit(Some(0.0)));
-            Ok::<_, std::io::Error>(h)
+            let w = Box::new(waker.clone());
+            SimHandle::spawn(model.clone(), p, origin.clone(), speed, false, w)
         };
-        let (a, b) = (spawn(params_a)?, spawn(params_b)?);
+        let (mut a, mut b) = (spawn(params_a)?, spawn(params_b)?);
         let first = |h: &SimHandle| h.latest().expect("the first frame is published at spawn");
         let shown = (first(&a), first(&b));
+        let start = shown.0.snapshot.time;
+        a.send(Command::SetLimit(Some(start)));
+        b.send(Command::SetLimit(Some(start)));
         let mut pair = SimPair {
             a,
             b,
-            target: 0.0,
+            start,
+            target: start,
             mode: Mode::Paused,
             speed,
             chunk: MAX_SPEED_CHUNK.0,
@@ -133,9 +139,9 @@ impl SimPair {
             }
             Command::Reset => {
                 self.mode = Mode::Paused;
-                self.target = 0.0;
+                self.target = self.start;
                 self.both(Command::Pause);
-                self.both(Command::SetLimit(Some(0.0)));
+                self.both(Command::SetLimit(Some(self.start)));
                 self.both(Command::Reset);
             }
             Command::SetSpeed(s) => {

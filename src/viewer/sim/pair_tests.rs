@@ -16,7 +16,7 @@ fn spawn(speed: Speed, play: bool) -> SimPair {
     let s = rockfall();
     let spec = CompareSpec::parse(Some("penalty"), None).unwrap().unwrap();
     let b = spec.derive(&s.params).unwrap();
-    SimPair::spawn(s.model, s.params, b, speed, play, || {}).unwrap()
+    SimPair::spawn(s.model, (s.params, b), None, speed, play, || {}).unwrap()
 }
 
 const WAIT: Duration = Duration::from_secs(60);
@@ -118,4 +118,36 @@ fn a_parameter_change_sent_to_b_alone_reaches_b_and_not_a() {
         before.0.params.joint.friction_angle
     );
     assert_eq!(a.snapshot.time.to_bits(), b.snapshot.time.to_bits());
+}
+
+/// `view --resume CHECKPOINT --compare METHOD`: both runs start from the checkpoint, at its
+/// time, move on in lock-step from there, and Reset takes both back to it.
+#[test]
+fn a_comparison_from_a_checkpoint_starts_and_resets_there() {
+    use crate::solver::{Solver, checkpoint};
+    let s = rockfall();
+    let mut solver = Solver::new(s.model.clone(), s.params.clone());
+    for _ in 0..20 {
+        solver.step().unwrap();
+    }
+    let t0 = solver.time;
+    let origin: Origin = checkpoint::encode(&solver).into();
+    let spec = CompareSpec::parse(Some("penalty"), None).unwrap().unwrap();
+    let b = spec.derive(&solver.params).unwrap();
+    let params = (solver.params.clone(), b);
+    let mut pair = SimPair::spawn(s.model, params, Some(origin), Speed::Max, true, || {}).unwrap();
+    let (a, b) = pair.tick();
+    assert_eq!((a.snapshot.time, b.snapshot.time), (t0, t0));
+    let (a, b) = pair
+        .wait_for(WAIT, |a, _| a.snapshot.time >= t0 + 0.05)
+        .expect("both move on from the checkpoint");
+    assert_eq!(a.snapshot.time.to_bits(), b.snapshot.time.to_bits());
+    assert!(a.snapshot.step > 20 && b.snapshot.step > 20);
+    pair.command(Command::Reset);
+    let (a, b) = pair
+        .wait_for(WAIT, |a, b| {
+            a.generation > 0 && b.generation > 0 && a.snapshot.step == 20 && b.snapshot.step == 20
+        })
+        .expect("both back at the checkpoint");
+    assert_eq!((a.snapshot.time, b.snapshot.time), (t0, t0));
 }

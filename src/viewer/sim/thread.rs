@@ -6,11 +6,11 @@ use std::sync::{Arc, Mutex};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-use super::{Command, Frame, Mailbox, RunState, Speed, StepRecord, lock, states};
+use super::{Command, Frame, Mailbox, Origin, RunState, Speed, StepRecord, lock, states};
 use crate::model::Model;
 use crate::params::SolverParams;
 use crate::snapshot::ContactState;
-use crate::solver::Solver;
+use crate::solver::{Solver, checkpoint};
 
 /// Prefix of the message for a SetParams that failed validation.
 const REJECTED: &str = "parameters not applied";
@@ -25,17 +25,20 @@ const LIMIT_SNAP: f64 = 1e-12;
 /// Window over which steps per second are measured.
 const RATE_WINDOW: Duration = Duration::from_millis(500);
 
-/// Starts the thread on `model`; the first frame (t = 0) is in the mailbox when this returns.
+/// Starts the thread on `model`, or from the checkpoint `origin` (of `model`'s blocks, `params`
+/// its settings) where one is given; the first frame is in the mailbox when this returns.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn start(
     model: Model,
     params: SolverParams,
+    origin: Option<Origin>,
     speed: Speed,
     play: bool,
     mailbox: Arc<Mutex<Mailbox>>,
     waker: Box<dyn Fn() + Send>,
     rx: Receiver<(u64, Command)>,
 ) -> std::io::Result<JoinHandle<()>> {
-    let mut sim = Sim::new(model, params, speed, mailbox, waker);
+    let mut sim = Sim::new(model, params, origin, speed, mailbox, waker);
     if play {
         sim.play();
     }
@@ -49,9 +52,29 @@ pub(super) fn start(
         .spawn(move || sim.run(rx))
 }
 
+/// The solver a run starts with, and starts over with on Reset: the scene's `model` at t = 0,
+/// or the checkpoint `origin` (decoded when the viewer opened, so it decodes again), each with
+/// `params`, the panel's settings. Settings other than the checkpoint's wake its sleeping
+/// blocks, as a change in the panel does.
+fn starting_solver(model: &Model, params: SolverParams, origin: Option<&[u8]>) -> Solver {
+    let Some(bytes) = origin else {
+        return Solver::new(model.clone(), params);
+    };
+    let mut solver =
+        checkpoint::decode(bytes).expect("the checkpoint decoded when the viewer opened");
+    if solver.params != params {
+        solver.wake_all();
+    }
+    solver.params = params;
+    solver
+}
+
 /// The thread's state.
 struct Sim {
     model: Model,
+    /// The checkpoint the run started from (`view --resume`), which Reset goes back to; `None`:
+    /// the scene at t = 0.
+    origin: Option<Origin>,
     /// The scene's end time, restored on reset and used as the increment past the end.
     scene_duration: f64,
     solver: Solver,
@@ -92,6 +115,7 @@ impl Sim {
     fn new(
         model: Model,
         params: SolverParams,
+        origin: Option<Origin>,
         speed: Speed,
         mailbox: Arc<Mutex<Mailbox>>,
         waker: Box<dyn Fn() + Send>,
@@ -99,8 +123,9 @@ impl Sim {
         let now = Instant::now();
         Sim {
             scene_duration: params.duration,
-            solver: Solver::new(model.clone(), params),
+            solver: starting_solver(&model, params, origin.as_deref()),
             model,
+            origin,
             state: RunState::Paused,
             speed,
             error: None,
@@ -265,7 +290,7 @@ impl Sim {
             Command::Reset => {
                 let mut params = self.solver.params.clone();
                 params.duration = self.scene_duration;
-                self.start_over(Solver::new(self.model.clone(), params));
+                self.start_over(starting_solver(&self.model, params, self.origin.as_deref()));
             }
             Command::SetParams(p) => match p.validate() {
                 Ok(()) => {
