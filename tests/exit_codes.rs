@@ -213,3 +213,43 @@ fn a_model_of_fixed_blocks_only_completes() {
             .unwrap();
     assert_eq!(summary["status"], "completed");
 }
+
+/// A failed write to stdout or stderr (a full disk, a closed pipe) is an I/O error, status 74
+/// with one line where stderr takes it, not a panic's report and 101: `cut`'s report to a full
+/// stdout, and `generate`'s line to a full stderr.
+#[test]
+fn a_standard_stream_that_cannot_be_written_is_an_io_error() {
+    let full = || {
+        std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap()
+    };
+    let dir = fresh_dir("full_stream");
+    let rock_mass = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/jointed_slope_small.toml");
+    let out = Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        .arg("cut")
+        .arg(&rock_mass)
+        .arg("--out")
+        .arg(dir.join("cut.toml"))
+        .stdout(full())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(
+        out.status.code(),
+        Some(i32::from(Status::Io.code())),
+        "{err}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("failed printing to stdout"), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+
+    let out = Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        .args(["generate", "column", "--blocks", "5", "--out"])
+        .arg(dir.join("column.toml"))
+        .stderr(full())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(i32::from(Status::Io.code())));
+}

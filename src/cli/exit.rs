@@ -6,7 +6,7 @@
 //! | 1 | the run diverged: a NaN, a runaway penetration at the smallest Δt, or the energy watchdog; everything written up to then is kept | `diverged` |
 //! | 2 | bad input or usage: the scene file, a flag, or no GPU adapter for `render` / `view` | none written |
 //! | 70 | a failure that is neither the run nor its input nor a file: the GPU device, the window, a worker thread | — |
-//! | 74 | an I/O error (sysexits' `EX_IOERR`): the output directory cannot be created, or a write fails (disk full); complete rows are kept | `io_error` |
+//! | 74 | an I/O error (sysexits' `EX_IOERR`): the output directory cannot be created, or a write fails (disk full; stdout or stderr included); complete rows are kept | `io_error` |
 //! | 101 | a bug (a Rust panic); the last checkpoint stays | `running` |
 //! | 130 | SIGINT (Ctrl-C): the step in progress was finished and everything written | `interrupted` |
 //! | 143 | SIGTERM: as SIGINT | `interrupted` |
@@ -16,6 +16,7 @@
 //! SIGINT or SIGTERM while the first is being handled exits at once with the same status,
 //! leaving the outputs as of the last checkpoint (`"status": "running"`).
 
+use std::io::Write;
 use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -46,6 +47,23 @@ impl Status {
             Status::Interrupted(s) => s.code(),
         }
     }
+}
+
+/// Makes a failed write to stdout or stderr an I/O error: `println!` and `eprintln!` panic when
+/// the stream cannot be written (`cut SCENE > /dev/full`, a closed pipe, stderr on a full
+/// disk), and such a panic now ends the process with [`Status::Io`] and one line on stderr,
+/// where stderr still takes it, instead of a bug's report and status 101. Every other panic
+/// keeps Rust's report. Set once, first thing in `main`.
+pub fn exit_on_failed_prints() {
+    let report = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info.payload_as_str().unwrap_or("");
+        if message.starts_with("failed printing to std") {
+            let _ = writeln!(std::io::stderr(), "error: {message}");
+            std::process::exit(i32::from(Status::Io.code()));
+        }
+        report(info);
+    }));
 }
 
 /// A signal that asks a run to stop.

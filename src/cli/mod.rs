@@ -212,6 +212,7 @@ pub fn dispatch(cli: &Cli) -> Result<(), CliError> {
 /// as one line on stderr with its exit status ([`exit`] has the table). Call it first thing in
 /// `main`, before any other thread starts (it may set an environment variable).
 pub fn main_entry() -> ExitCode {
+    exit::exit_on_failed_prints();
     quiet_mesa_runtime_dir();
     let cli = parse_command_line();
     // `run` and `render` say which kind of failure ended them. Of the others, `generate` can
