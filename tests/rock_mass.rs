@@ -251,6 +251,11 @@ fn bad_rock_masses_are_one_line_errors() {
             ),
             "overlaps region 1",
         ),
+        // A min_volume above every piece left an empty model that ran and "completed".
+        (
+            format!("{}min_volume = 70.0\n{good}", mass(cube, "")),
+            "min_volume = 70 m³ drops every piece of the cut (",
+        ),
     ] {
         let start = std::time::Instant::now();
         let e = scene::parse(&text, "mass.toml", "mass").expect_err(want);

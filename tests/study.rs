@@ -335,6 +335,11 @@ fn bad_study_files_are_one_line_and_exit_2() {
             format!("scene = {sliding:?}\n{head}watch = [\"column*\"]\n{ok_param}"),
             "watch: \"column*\" matches no free block",
         ),
+        // Numbers short (serde printed 1e300's 301 digits).
+        (
+            format!("scene = {sliding:?}\n{head}toppled_angle = 1e300\n{ok_param}"),
+            "toppled_angle = 1e300: must be between 0 and 180 degrees",
+        ),
         // A device that never ends is read only up to a scene file's limit (it filled the
         // memory before).
         (

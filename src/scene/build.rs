@@ -8,6 +8,7 @@ use crate::contact::Shape;
 use crate::contact::detection::broad_phase;
 use crate::contact::groups::MAX_BLOCK_PAIRS;
 use crate::model::Block;
+use crate::params::SolverParams;
 use crate::physics::geometry::{
     Vec3, bounding_box, box_vertices, convex_hull, dodecahedron_vertices, overlap_depth,
     prism_vertices, rotation_xyz_degrees,
@@ -85,6 +86,26 @@ pub(super) fn check_material(name: &str, m: &Material) -> Result<(), (&'static s
         ));
     }
     Ok(())
+}
+
+/// Checks the initial penalty against the scene's stiffest material (Young's modulus
+/// `young`, Pa): at least 10⁻⁶ E, below which blocks pass through each other before any
+/// contact holds them, and at most the (P21b) cap γ·E that no penalty may pass.
+pub(super) fn check_penalty_scale(params: &SolverParams, young: f64) -> Result<(), String> {
+    let (p, gamma) = (params.contact.initial_penalty, params.contact.gamma);
+    let (lo, hi) = (1e-6 * young, gamma * young);
+    if (lo..=hi).contains(&p) {
+        return Ok(());
+    }
+    Err(format!(
+        "solver.contact.initial_penalty = {} N/m must lie in [1e-6, γ] times the stiffest \
+         material's E = {} Pa (γ = {}): [{}, {}] N/m",
+        short(p),
+        short(young),
+        short(gamma),
+        short(lo),
+        short(hi)
+    ))
 }
 
 /// An error when a shape has more points than [`MAX_BLOCK_POINTS`] (`what` says which points):
@@ -252,4 +273,32 @@ pub(super) fn check_overlaps(blocks: &[Block]) -> Result<(), (usize, String)> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The initial penalty lies within [10⁻⁶, γ] times the stiffest E, ends included; the
+    /// message gives the range in N/m.
+    #[test]
+    fn the_initial_penalty_is_held_to_the_stiffest_material() {
+        let with = |p: f64, gamma: f64| {
+            let mut s = SolverParams::default();
+            s.contact.initial_penalty = p;
+            s.contact.gamma = gamma;
+            s
+        };
+        let e = 2.0e10;
+        for p in [2e4, 2e8, 2e12] {
+            assert!(check_penalty_scale(&with(p, 100.0), e).is_ok(), "{p}");
+        }
+        for p in [1.9e4, 2.1e12, 1e30] {
+            let m = check_penalty_scale(&with(p, 100.0), e).unwrap_err();
+            assert!(m.contains("[20000, 2e12] N/m"), "{m}");
+        }
+        // A cap below the start: no penalty could be both.
+        let m = check_penalty_scale(&with(2e8, 1e-3), e).unwrap_err();
+        assert!(m.contains("γ = 0.001"), "{m}");
+    }
 }

@@ -34,7 +34,7 @@ use std::fmt;
 use std::io::Read;
 use std::path::Path;
 
-use build::{build_block, check_material, check_overlaps};
+use build::{build_block, check_material, check_overlaps, check_penalty_scale};
 use format::SceneFile;
 use locate::{LineIndex, key_at, key_line, line_of};
 
@@ -42,7 +42,7 @@ pub use crate::rockmass::report::RockMassReport;
 pub use write::cut_scene;
 
 use crate::model::{Block, Model, RockMassOf};
-use crate::params::{JointSetParams, SolverParams};
+use crate::params::{JointSetParams, SolverParams, table};
 use crate::physics::geometry::convex_hull;
 use crate::physics::mechanics::Material;
 use crate::text::{one_line, short};
@@ -219,7 +219,7 @@ fn toml_error(text: &str, e: &toml::de::Error) -> (Option<usize>, String) {
 
 /// The message with every number of more than 12 characters written short: serde prints a
 /// float in full, 309 digits for `1e308` where an integer was expected.
-fn shorten_numbers(message: &str) -> String {
+pub(crate) fn shorten_numbers(message: &str) -> String {
     let is_num = |c: char| c.is_ascii_digit() || matches!(c, '.' | '-' | '+' | 'e' | 'E');
     let mut out = String::with_capacity(message.len());
     let mut rest = message;
@@ -291,6 +291,15 @@ fn parse_cut(
             let line = key_line(text, &["materials", name, key])
                 .unwrap_or_else(|| line_of(text, m.span().start));
             err(Some(line), e)
+        })?;
+    }
+    let stiffest = file.materials.values().map(|m| m.get_ref().young_modulus);
+    if let Some(young) = stiffest.reduce(f64::max) {
+        check_penalty_scale(&params, young).map_err(|m| {
+            err(
+                first_key_line(text, &[table::INITIAL_PENALTY.key, table::GAMMA.key]),
+                m,
+            )
         })?;
     }
     if file.blocks.is_empty() && file.rock_masses.is_empty() {

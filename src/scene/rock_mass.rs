@@ -131,6 +131,15 @@ pub(super) fn cut_mass(
     if min_volume.is_none() {
         drop_below_median_fraction(&mut pieces, &mut report);
     }
+    // A rock mass of no block would run an empty model (`run` completed with no rows).
+    if pieces.is_empty() {
+        return Err(format!(
+            "min_volume = {} m³ drops every piece of the cut ({} of them, {} m³ in all): no block is left",
+            short(opts.min_volume),
+            report.dropped,
+            short(report.dropped_volume)
+        ));
+    }
     let blocks: Vec<CutBlock> = pieces
         .into_iter()
         .enumerate()

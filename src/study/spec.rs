@@ -9,6 +9,7 @@ use super::draw::{self, Distribution};
 use super::keys::{override_scene_text, value_at};
 use super::outcomes::{Outcome, OutcomeSettings, watched};
 use super::{MAX_CASES, Parameter, Study, StudyError};
+use crate::scene::shorten_numbers;
 
 /// The outcomes of a study file without `outcomes`: the list (#18) of what a rockfall or
 /// slope study is judged by.
@@ -134,7 +135,9 @@ fn read(path: &Path, kind: &str) -> Result<String, String> {
 /// Reads and checks a study file and its base scene.
 pub(super) fn load(path: &Path) -> Result<Study, StudyError> {
     let shown = path.display().to_string();
-    let fail = |m: String| StudyError::input(format!("{shown}: {m}"));
+    // Numbers short, as a scene file's errors have them (`toppled_angle = 1e300`, not 301
+    // digits).
+    let fail = |m: String| StudyError::input(format!("{shown}: {}", shorten_numbers(&m)));
     let text = read(path, "a study file").map_err(fail)?;
     let file: StudyFile = toml::from_str(&text).map_err(|e| {
         let line = e

@@ -12,8 +12,10 @@ pub const INITIAL_PENALTY: Param = Param {
     default: Value::Real(2.0e8),
     get: |p| Value::Real(p.contact.initial_penalty),
     set: |p, text| assign(text, &mut p.contact.initial_penalty),
-    valid: Interval::POSITIVE,
-    valid_why: "",
+    valid: Interval::new(Bound::Closed(1.0), Bound::Closed(1e16)),
+    valid_why: "outside it the penalty is no contact spring for any material dda3d takes \
+          (E in [1e2, 1e13] Pa): at 1e30 or 1e300 N/m the first solve was not finite; the scene \
+          also holds it within [1e-6, γ] times its stiffest material's E.",
     widget: Some(Widget {
         range: WidgetRange::TimesYoung(1e-6, 100.0),
         logarithmic: true,
@@ -57,8 +59,9 @@ pub const GAMMA: Param = Param {
     default: Value::Real(100.0),
     get: |p| Value::Real(p.contact.gamma),
     set: |p, text| assign(text, &mut p.contact.gamma),
-    valid: Interval::POSITIVE,
-    valid_why: "",
+    valid: Interval::new(Bound::Open(0.0), Bound::Closed(1e6)),
+    valid_why: "a cap above 10⁶ E lets a contact's stiffness swamp its blocks' in K beyond what \
+          f64 solves (at 1e300 the solution was not finite).",
     widget: absolute(0.01, 1000.0, true),
 };
 
@@ -125,8 +128,9 @@ pub const SHEAR_PENALTY_RATIO: Param = Param {
     default: Value::Real(1.0 / 2.5),
     get: |p| Value::Real(p.contact.shear_penalty_ratio),
     set: |p, text| assign(text, &mut p.contact.shear_penalty_ratio),
-    valid: Interval::POSITIVE,
-    valid_why: "",
+    valid: Interval::new(Bound::Closed(1e-4), Bound::Closed(100.0)),
+    valid_why: "below 10⁻⁴ a locked contact holds nothing in shear, above 100 its shear spring \
+          swamps the normal one (at 1e300 the first solve was not finite).",
     widget: absolute(0.01, 10.0, true),
 };
 
