@@ -251,6 +251,12 @@ fn bad_rock_masses_are_one_line_errors() {
             ),
             "overlaps region 1",
         ),
+        // Forty sets through one point: about a thousand blocks that all meet there, each box
+        // over every other (one step of sixty such sets took 10.9 GB).
+        (
+            mass(cube, &star_of_sets(40)),
+            "a block (more than 200): block 'm/",
+        ),
         // A min_volume above every piece left an empty model that ran and "completed".
         (
             format!("{}min_volume = 70.0\n{good}", mass(cube, "")),
@@ -265,6 +271,18 @@ fn bad_rock_masses_are_one_line_errors() {
         assert_eq!(line.lines().count(), 1);
         assert!(start.elapsed().as_secs_f64() < 5.0, "{want}: slow");
     }
+}
+
+/// `n` joint sets through the origin, spread in dip and dip direction (golden-angle steps), one
+/// plane each: every block they cut has the origin as a corner.
+fn star_of_sets(n: usize) -> String {
+    (0..n)
+        .map(|k| {
+            let dip = 5.0 + (k as f64 * 0.618_034 * 80.0) % 80.0;
+            let dd = (k as f64 * 137.507_764) % 360.0;
+            set(&format!("S{k}"), dip, dd, 100.0, [0.0; 3], "")
+        })
+        .collect()
 }
 
 /// `dda3d run` on a rock mass reports the cut in summary.json, as `dda3d cut` prints it: blocks,
