@@ -64,7 +64,8 @@ impl SimHandle {
     /// from the checkpoint `origin` (`view --resume`: encoded, of `model`'s blocks, `params`
     /// its settings), which Reset then goes back to. `waker` is called (from the sim thread)
     /// when a new frame is waiting; the window uses it to schedule a redraw. The first frame
-    /// (t = 0, or the checkpoint's time) is published before this returns.
+    /// (t = 0, or the checkpoint's time) is published before this returns. An `origin` that
+    /// does not decode is an error of kind `InvalidData`, and no thread starts.
     pub fn spawn(
         model: Model,
         params: SolverParams,
@@ -75,16 +76,12 @@ impl SimHandle {
     ) -> std::io::Result<SimHandle> {
         let (tx, rx) = mpsc::channel();
         let mailbox = Arc::new(Mutex::new(Mailbox::default()));
-        let thread = thread::start(
+        let start = thread::Start {
             model,
             params,
             origin,
-            speed,
-            play,
-            mailbox.clone(),
-            waker,
-            rx,
-        )?;
+        };
+        let thread = thread::start(start, (speed, play), mailbox.clone(), waker, rx)?;
         Ok(SimHandle {
             tx,
             mailbox,
@@ -354,6 +351,21 @@ mod tests {
         let id = h.send(Command::Reset);
         let f = h.wait_for(WAIT, |f| f.applied >= id).unwrap();
         assert_eq!((f.snapshot.time, f.snapshot.step), (at.time, 20));
+        // Bytes that are no checkpoint start nothing.
+        let junk: Origin = vec![0u8; 64].into();
+        let s = rockfall();
+        let e = SimHandle::spawn(
+            s.model,
+            s.params,
+            Some(junk),
+            Speed::Max,
+            false,
+            Box::new(|| {}),
+        );
+        assert_eq!(
+            e.err().map(|e| e.kind()),
+            Some(std::io::ErrorKind::InvalidData)
+        );
         assert_eq!(f.snapshot.blocks[1].vertices, at.blocks[1].vertices);
         assert_eq!(f.generation, 1);
     }

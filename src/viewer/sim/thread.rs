@@ -25,20 +25,46 @@ const LIMIT_SNAP: f64 = 1e-12;
 /// Window over which steps per second are measured.
 const RATE_WINDOW: Duration = Duration::from_millis(500);
 
-/// Starts the thread on `model`, or from the checkpoint `origin` (of `model`'s blocks, `params`
-/// its settings) where one is given; the first frame is in the mailbox when this returns.
-#[allow(clippy::too_many_arguments)]
+/// What a simulation thread runs: the scene's `model` with `params` (`params.duration` is the
+/// end time), from t = 0 or from the checkpoint `origin` (of `model`'s blocks, `params` its
+/// settings), which Reset goes back to.
+pub(super) struct Start {
+    pub model: Model,
+    pub params: SolverParams,
+    pub origin: Option<Origin>,
+}
+
+impl Start {
+    /// The solver a run starts with, and starts over with on Reset, with `params` (the
+    /// panel's): the model at t = 0, or the checkpoint decoded. Settings other than the
+    /// checkpoint's wake its sleeping blocks, as a change in the panel does. A checkpoint that
+    /// does not decode is an error (checked when the thread starts, so Reset never meets one).
+    fn solver(&self, params: SolverParams) -> Result<Solver, String> {
+        let Some(bytes) = self.origin.as_deref() else {
+            return Ok(Solver::new(self.model.clone(), params));
+        };
+        let mut solver = checkpoint::decode(bytes).map_err(|e| e.to_string())?;
+        if solver.params != params {
+            solver.wake_all();
+        }
+        solver.params = params;
+        Ok(solver)
+    }
+}
+
+/// Starts the thread on `start`; the first frame is in the mailbox when this returns. A
+/// checkpoint that does not decode is an error of kind `InvalidData`.
 pub(super) fn start(
-    model: Model,
-    params: SolverParams,
-    origin: Option<Origin>,
-    speed: Speed,
-    play: bool,
+    start: Start,
+    (speed, play): (Speed, bool),
     mailbox: Arc<Mutex<Mailbox>>,
     waker: Box<dyn Fn() + Send>,
     rx: Receiver<(u64, Command)>,
 ) -> std::io::Result<JoinHandle<()>> {
-    let mut sim = Sim::new(model, params, origin, speed, mailbox, waker);
+    let solver = start
+        .solver(start.params.clone())
+        .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))?;
+    let mut sim = Sim::new(start, solver, speed, mailbox, waker);
     if play {
         sim.play();
     }
@@ -52,29 +78,10 @@ pub(super) fn start(
         .spawn(move || sim.run(rx))
 }
 
-/// The solver a run starts with, and starts over with on Reset: the scene's `model` at t = 0,
-/// or the checkpoint `origin` (decoded when the viewer opened, so it decodes again), each with
-/// `params`, the panel's settings. Settings other than the checkpoint's wake its sleeping
-/// blocks, as a change in the panel does.
-fn starting_solver(model: &Model, params: SolverParams, origin: Option<&[u8]>) -> Solver {
-    let Some(bytes) = origin else {
-        return Solver::new(model.clone(), params);
-    };
-    let mut solver =
-        checkpoint::decode(bytes).expect("the checkpoint decoded when the viewer opened");
-    if solver.params != params {
-        solver.wake_all();
-    }
-    solver.params = params;
-    solver
-}
-
 /// The thread's state.
 struct Sim {
-    model: Model,
-    /// The checkpoint the run started from (`view --resume`), which Reset goes back to; `None`:
-    /// the scene at t = 0.
-    origin: Option<Origin>,
+    /// What the run started from, and Reset goes back to.
+    start: Start,
     /// The scene's end time, restored on reset and used as the increment past the end.
     scene_duration: f64,
     solver: Solver,
@@ -113,19 +120,17 @@ struct Sim {
 
 impl Sim {
     fn new(
-        model: Model,
-        params: SolverParams,
-        origin: Option<Origin>,
+        start: Start,
+        solver: Solver,
         speed: Speed,
         mailbox: Arc<Mutex<Mailbox>>,
         waker: Box<dyn Fn() + Send>,
     ) -> Sim {
         let now = Instant::now();
         Sim {
-            scene_duration: params.duration,
-            solver: starting_solver(&model, params, origin.as_deref()),
-            model,
-            origin,
+            scene_duration: start.params.duration,
+            solver,
+            start,
             state: RunState::Paused,
             speed,
             error: None,
@@ -290,7 +295,8 @@ impl Sim {
             Command::Reset => {
                 let mut params = self.solver.params.clone();
                 params.duration = self.scene_duration;
-                self.start_over(starting_solver(&self.model, params, self.origin.as_deref()));
+                let solver = self.start.solver(params);
+                self.start_over(solver.expect("the checkpoint decoded when the thread started"));
             }
             Command::SetParams(p) => match p.validate() {
                 Ok(()) => {
@@ -329,7 +335,7 @@ impl Sim {
                 Ok(m) => self.notice = Some((id, m)),
                 Err(m) => self.error = Some(m),
             },
-            Command::LoadState(path) => match states::load(&path, &self.model) {
+            Command::LoadState(path) => match states::load(&path, &self.start.model) {
                 Ok(solver) => {
                     self.start_over(solver);
                     self.state = RunState::Paused;
