@@ -280,7 +280,6 @@ pub(super) fn check_overlaps(blocks: &[Block]) -> Result<(), (usize, String)> {
         })
         .collect();
     let pairs = broad_phase(&shapes, 0.0, MAX_BLOCK_PAIRS);
-    check_pairs_per_block(&pairs, blocks)?;
     // Each pair would be checked here, and (unless both are fixed) searched for contacts at
     // every step. The error names the line of a block of one of them.
     if let Some(&(_, b)) = pairs.get(MAX_BLOCK_PAIRS) {
@@ -295,6 +294,9 @@ pub(super) fn check_overlaps(blocks: &[Block]) -> Result<(), (usize, String)> {
             ),
         ));
     }
+    // Within the whole search's limit, the pairs per block (the search stops past the limit,
+    // so only then is the count a block's own).
+    check_pairs_per_block(&pairs, blocks)?;
     for (a, b) in pairs {
         let depth = overlap_depth(
             &blocks[a].vertices,
