@@ -286,22 +286,7 @@ fn parse_cut(
             .map_err(|m| err(key_line(text, &["output", "interval"]), m))?;
     }
 
-    for (name, m) in &file.materials {
-        check_material(name, m.get_ref()).map_err(|(key, e)| {
-            let line = key_line(text, &["materials", name, key])
-                .unwrap_or_else(|| line_of(text, m.span().start));
-            err(Some(line), e)
-        })?;
-    }
-    let stiffest = file.materials.values().map(|m| m.get_ref().young_modulus);
-    if let Some(young) = stiffest.reduce(f64::max) {
-        check_penalty_scale(&params, young).map_err(|m| {
-            err(
-                first_key_line(text, &[table::INITIAL_PENALTY.key, table::GAMMA.key]),
-                m,
-            )
-        })?;
-    }
+    check_materials(&file, &params, text).map_err(|(line, m)| err(line, m))?;
     if file.blocks.is_empty() && file.rock_masses.is_empty() {
         return Err(err(
             None,
@@ -386,6 +371,30 @@ fn parse_cut(
         sets: sets.split_off(first_cut_set),
     };
     Ok((scene, cut))
+}
+
+/// Checks each material's constants, then the initial penalty against the stiffest one; an
+/// error comes with the line of the key it concerns.
+fn check_materials(
+    file: &SceneFile,
+    params: &SolverParams,
+    text: &str,
+) -> Result<(), (Option<usize>, String)> {
+    for (name, m) in &file.materials {
+        check_material(name, m.get_ref()).map_err(|(key, e)| {
+            let line = key_line(text, &["materials", name, key])
+                .unwrap_or_else(|| line_of(text, m.span().start));
+            (Some(line), e)
+        })?;
+    }
+    let stiffest = file.materials.values().map(|m| m.get_ref().young_modulus);
+    if let Some(young) = stiffest.reduce(f64::max) {
+        check_penalty_scale(params, young).map_err(|m| {
+            let keys = [table::INITIAL_PENALTY.key, table::GAMMA.key];
+            (first_key_line(text, &keys), m)
+        })?;
+    }
+    Ok(())
 }
 
 /// The rock masses' names, by the index blocks and joint sets carry: those of `[[rock_masses]]`,
