@@ -271,4 +271,45 @@ fn render_resumes_from_a_checkpoint() {
         let img = image::open(frames.join(&r[3])).unwrap();
         assert_eq!((img.width(), img.height()), (320, 180));
     }
+
+    // Compared: both halves start from the checkpoint (its time and step on both sides of the
+    // first row), then each takes its own steps to the same frame times.
+    let pair = tmp.join("pair");
+    let o = dda3d(&[
+        os("render"),
+        os("--resume"),
+        ckpt.as_os_str(),
+        os("--compare"),
+        os("penalty"),
+        os("--duration"),
+        os("0.7"),
+        os("--fps"),
+        os("10"),
+        os("--width"),
+        os("320"),
+        os("--height"),
+        os("180"),
+        os("--msaa"),
+        os("1"),
+        os("--quiet"),
+        os("--out"),
+        pair.as_os_str(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(pair.join("frames.csv")).unwrap();
+    let rows: Vec<Vec<String>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect();
+    assert_eq!(rows.len(), 3, "{csv}");
+    assert_eq!(
+        (&rows[0][1], &rows[0][2]),
+        (&rows[0][4], &rows[0][5]),
+        "{csv}"
+    );
+    assert_eq!(rows[0][2], steps[0].to_string(), "{csv}");
+    for r in &rows[1..] {
+        assert_eq!(r[1], r[4], "one time on both sides: {csv}");
+    }
 }

@@ -33,11 +33,11 @@ pub struct RenderArgs {
     /// equilibrium stage is then computed once, not for every render. The first frame is the
     /// checkpoint's state at its time t, the next ones fall on the multiples of 1/fps after it;
     /// the solver settings are the checkpoint's, and --duration is the new end time (from
-    /// t = 0, as in the scene).
+    /// t = 0, as in the scene). With --compare, both runs start from the checkpoint.
     #[arg(
         long,
         value_name = "CHECKPOINT",
-        conflicts_with_all = ["scene", "method", "mode", "spectral_radius", "max_time_step", "initial_equilibrium", "sleep_velocity", "compare", "compare_set"]
+        conflicts_with_all = ["scene", "method", "mode", "spectral_radius", "max_time_step", "initial_equilibrium", "sleep_velocity"]
     )]
     pub resume: Option<PathBuf>,
     /// Frames per second of simulated time.
@@ -166,15 +166,16 @@ pub(super) fn execute(args: &RenderArgs) -> Result<(), Failure> {
             let solver = super::resume::resume(path, &args.overrides)?;
             check_image_options(args)?;
             let out = super::resume::default_out(&solver);
+            if let Some(spec) = compare_spec(args)? {
+                check_frame_count(solver.params.duration - solver.time, args.fps)?;
+                return super::render_compare::execute_from(args, solver, &spec, out);
+            }
             (solver, out)
         }
         None => {
             let scene = load_scene(args.source(), &args.overrides)?;
             check_image_options(args)?;
-            if let Some(spec) =
-                CompareSpec::parse(args.compare.as_deref(), args.compare_set.as_deref())
-                    .map_err(|e| Failure::Input(e.to_string()))?
-            {
+            if let Some(spec) = compare_spec(args)? {
                 check_frame_count(scene.params.duration, args.fps)?;
                 return super::render_compare::execute(args, scene, &spec);
             }
@@ -205,6 +206,12 @@ pub(super) fn execute(args: &RenderArgs) -> Result<(), Failure> {
         wall,
         (solver.time, "frames", "simulation"),
     )
+}
+
+/// `--compare`/`--compare-set` read, if given.
+fn compare_spec(args: &RenderArgs) -> Result<Option<CompareSpec>, Failure> {
+    CompareSpec::parse(args.compare.as_deref(), args.compare_set.as_deref())
+        .map_err(|e| Failure::Input(e.to_string()))
 }
 
 /// The end of a render (plain or compared): an early stop reported with the frames that were
@@ -382,7 +389,7 @@ fn simulate_frames(
 /// The numbers k of the frames after the first, at k/fps, from a start at `t0` to the end at
 /// `duration` (both within round-off of a frame time count as on it): 1..=⌊duration·fps⌋ from
 /// t = 0.
-fn frame_numbers(t0: f64, duration: f64, fps: f64) -> (u64, u64) {
+pub(super) fn frame_numbers(t0: f64, duration: f64, fps: f64) -> (u64, u64) {
     let first = (t0 * fps + 1e-9).floor() as u64 + 1;
     let last = (duration * fps + 1e-9).floor() as u64;
     (first, last)

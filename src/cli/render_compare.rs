@@ -10,32 +10,61 @@ use std::time::Instant;
 use super::Progress;
 use super::exit::{self, Failure};
 use super::render::{
-    RenderArgs, Simulated, capture_failure, capture_options, conclude, write_summary,
+    RenderArgs, Simulated, capture_failure, capture_options, conclude, frame_numbers, write_summary,
 };
 use crate::compare::{CompareSpec, caption, labels};
 use crate::output::slug;
 use crate::render::{FrameCapture, RenderError};
 use crate::scene::Scene;
-use crate::solver::Solver;
+use crate::solver::{Solver, checkpoint};
 
 /// `render --compare`: as `render`, with two runs in each frame.
 pub(super) fn execute(args: &RenderArgs, scene: Scene, spec: &CompareSpec) -> Result<(), Failure> {
     let params_b = spec
         .derive(&scene.params)
         .map_err(|e| Failure::Input(e.to_string()))?;
+    let out = PathBuf::from("out").join(slug(&scene.name));
+    let a = Solver::new(scene.model.clone(), scene.params);
+    let b = Solver::new(scene.model, params_b);
+    render_pair(args, a, b, out)
+}
+
+/// `render --resume CHECKPOINT --compare METHOD`: both runs start from the checkpoint's state
+/// `a`, B with its own settings (derived from the checkpoint's) and, where they differ, every
+/// block awake, as a comparison started from a checkpoint in the window does.
+pub(super) fn execute_from(
+    args: &RenderArgs,
+    a: Solver,
+    spec: &CompareSpec,
+    out: PathBuf,
+) -> Result<(), Failure> {
+    let params_b = spec
+        .derive(&a.params)
+        .map_err(|e| Failure::Input(e.to_string()))?;
+    let mut b = checkpoint::decode(&checkpoint::encode(&a))
+        .map_err(|e| Failure::Failed(format!("the checkpoint's copy for B: {e}")))?;
+    if b.params != params_b {
+        b.wake_all();
+    }
+    b.params = params_b;
+    render_pair(args, a, b, out)
+}
+
+/// Renders A and B side by side into `--out`, or `default_out/frames`.
+fn render_pair(
+    args: &RenderArgs,
+    mut a: Solver,
+    mut b: Solver,
+    default_out: PathBuf,
+) -> Result<(), Failure> {
     let out = args
         .out
         .clone()
-        .unwrap_or_else(|| PathBuf::from("out").join(slug(&scene.name)).join("frames"));
+        .unwrap_or_else(|| default_out.join("frames"));
     let mut opts = capture_options(args, &out)?;
-    let (la, lb) = labels(&scene.params, &params_b);
-    opts.sides = Some([
-        caption("A", &scene.params, &la),
-        caption("B", &params_b, &lb),
-    ]);
-    let name = scene.name.clone();
-    let mut a = Solver::new(scene.model.clone(), scene.params);
-    let mut b = Solver::new(scene.model, params_b);
+    let (la, lb) = labels(&a.params, &b.params);
+    opts.sides = Some([caption("A", &a.params, &la), caption("B", &b.params, &lb)]);
+    let name = a.model.name.clone();
     exit::catch_stop_signals()?;
     let capture = FrameCapture::start(opts).map_err(|e| capture_failure(&out, e))?;
     let start = Instant::now();
@@ -58,8 +87,8 @@ pub(super) fn execute(args: &RenderArgs, scene: Scene, spec: &CompareSpec) -> Re
     )
 }
 
-/// Steps both solvers to each frame time in turn and submits the pair there, frame 0
-/// included. Either run's failure ends both early (a half with nothing to show would not
+/// Steps both solvers to each frame time in turn and submits the pair there, the first frame
+/// (t = 0, or the checkpoint's time) included. Either run's failure ends both early (a half with nothing to show would not
 /// compare); a capture failure is the error.
 fn simulate_pairs(
     a: &mut Solver,
@@ -70,10 +99,10 @@ fn simulate_pairs(
     let mut simulated = Simulated::new();
     let frame_dt = 1.0 / args.fps;
     let duration = a.params.duration.min(b.params.duration);
-    let total_frames = (duration * args.fps + 1e-9).floor() as u64 + 1;
+    let (first, last) = frame_numbers(a.time, duration, args.fps);
     let mut progress = Progress::new(duration, args.quiet);
     capture.submit_pair(a.snapshot(), b.snapshot())?;
-    for k in 1..total_frames {
+    for k in first..=last {
         let t = k as f64 * frame_dt;
         if !(simulated.step_to(a, t, frame_dt) && simulated.step_to(b, t, frame_dt)) {
             break;
