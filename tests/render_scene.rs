@@ -9,6 +9,7 @@ use dda3d::render::{CaptureOptions, Offscreen};
 use dda3d::scene;
 use dda3d::solver::Solver;
 use render_support::*;
+use std::process::Output;
 
 const W: u32 = 1280;
 const H: u32 = 720;
@@ -152,23 +153,20 @@ fn os(s: &str) -> &std::ffi::OsStr {
     std::ffi::OsStr::new(s)
 }
 
-fn dda3d<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> std::process::Output {
+fn dda3d<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_dda3d"))
         .args(args)
         .output()
         .unwrap()
 }
 
-/// `render --resume`: the frames start from a checkpoint of `run` (a large rock mass's
-/// equilibrium stage computed once): the first frame is the checkpoint's state at its time and
-/// step, the next ones fall on the multiples of 1/fps after it, up to the new end time.
-#[test]
-fn render_resumes_from_a_checkpoint() {
-    let tmp = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_resume");
-    let _ = std::fs::remove_dir_all(&tmp);
+/// The rockfall run to 0.6 s with a checkpoint at its first step past 0.5 s, in `dir/run`:
+/// the checkpoint's file and time.
+fn rockfall_checkpoint(dir: &std::path::Path) -> (std::path::PathBuf, f64) {
+    let _ = std::fs::remove_dir_all(dir);
     let scene =
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rock_column_rockfall.toml");
-    let run = tmp.join("run");
+    let run = dir.join("run");
     let o = dda3d(&[
         os("run"),
         scene.as_os_str(),
@@ -190,69 +188,72 @@ fn render_resumes_from_a_checkpoint() {
         .parse()
         .unwrap();
     assert!((0.5..0.6).contains(&t0), "{t0}");
+    (ckpt, t0)
+}
 
-    // Bad uses need no GPU: an end before the checkpoint, a solver flag (the checkpoint's
-    // settings hold), a file that is not a checkpoint. One line each, exit 2.
+/// `render --resume CKPT` with `extra` flags into `out`, small and quiet.
+fn render_resumed(ckpt: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> Output {
+    let mut args = vec![os("render"), os("--resume"), ckpt.as_os_str()];
+    args.extend(extra.iter().map(|a| os(a)));
+    args.extend(
+        [
+            "--width", "320", "--height", "180", "--msaa", "1", "--quiet",
+        ]
+        .map(os),
+    );
+    args.extend([os("--out"), out.as_os_str()]);
+    dda3d(&args)
+}
+
+/// frames.csv's rows, split at the commas.
+fn frame_rows(dir: &std::path::Path) -> Vec<Vec<String>> {
+    let csv = std::fs::read_to_string(dir.join("frames.csv")).unwrap();
+    csv.lines()
+        .skip(1)
+        .map(|l| l.split(',').map(String::from).collect())
+        .collect()
+}
+
+/// `render --resume`, used badly: an end before the checkpoint, a solver flag (the
+/// checkpoint's settings hold), a bad image option, a file that is not a checkpoint. One line
+/// each, exit 2, nothing written; no GPU is needed to say so.
+#[test]
+fn render_from_a_checkpoint_refuses_bad_uses() {
+    let tmp = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_resume_bad");
+    let (ckpt, _) = rockfall_checkpoint(&tmp);
     let frames = tmp.join("frames");
-    let bad: [(&[&str], &str); 3] = [
-        (&["--duration", "0.3"], "give a later --duration"),
-        (&["--method", "penalty"], "cannot be used with"),
-        (&["--fps", "0"], "--fps must be positive"),
+    let not_one = tmp.join("run/summary.json");
+    let bad: [(&std::path::Path, &[&str], &str); 4] = [
+        (&ckpt, &["--duration", "0.3"], "give a later --duration"),
+        (&ckpt, &["--method", "penalty"], "cannot be used with"),
+        (&ckpt, &["--fps", "0"], "--fps must be positive"),
+        (&not_one, &[], "summary.json: not a dda3d checkpoint"),
     ];
-    for (extra, want) in bad {
-        let mut args = vec![os("render"), os("--resume"), ckpt.as_os_str()];
-        args.extend(extra.iter().map(|a| os(a)));
-        args.extend([os("--out"), frames.as_os_str()]);
-        let o = dda3d(&args);
+    for (file, extra, want) in bad {
+        let o = render_resumed(file, &frames, extra);
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(2), "{extra:?}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{err}");
         assert!(err.contains(want), "{extra:?}: {err}");
         assert!(!frames.exists(), "{extra:?}: nothing written");
     }
-    let not_one = run.join("summary.json");
-    let o = dda3d(&[
-        os("render"),
-        os("--resume"),
-        not_one.as_os_str(),
-        os("--out"),
-        frames.as_os_str(),
-    ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    assert!(
-        err.contains("summary.json: not a dda3d checkpoint"),
-        "{err}"
-    );
+}
 
+/// `render --resume`: the frames start from a checkpoint of `run` (a large rock mass's
+/// equilibrium stage computed once): the first frame is the checkpoint's state at its time and
+/// step, the next ones fall on the multiples of 1/fps after it, up to the new end time; with
+/// `--compare` both halves start there.
+#[test]
+fn render_resumes_from_a_checkpoint() {
     if gpu_or_skip("render_resumes_from_a_checkpoint").is_none() {
         return;
     }
-    let o = dda3d(&[
-        os("render"),
-        os("--resume"),
-        ckpt.as_os_str(),
-        os("--duration"),
-        os("0.8"),
-        os("--fps"),
-        os("10"),
-        os("--width"),
-        os("320"),
-        os("--height"),
-        os("180"),
-        os("--msaa"),
-        os("1"),
-        os("--quiet"),
-        os("--out"),
-        frames.as_os_str(),
-    ]);
+    let tmp = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_resume");
+    let (ckpt, t0) = rockfall_checkpoint(&tmp);
+    let frames = tmp.join("frames");
+    let o = render_resumed(&ckpt, &frames, &["--duration", "0.8", "--fps", "10"]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let csv = std::fs::read_to_string(frames.join("frames.csv")).unwrap();
-    let rows: Vec<Vec<String>> = csv
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(String::from).collect())
-        .collect();
+    let rows = frame_rows(&frames);
     let times: Vec<f64> = rows.iter().map(|r| r[1].parse().unwrap()).collect();
     let steps: Vec<u64> = rows.iter().map(|r| r[2].parse().unwrap()).collect();
     assert_eq!(
@@ -275,41 +276,14 @@ fn render_resumes_from_a_checkpoint() {
     // Compared: both halves start from the checkpoint (its time and step on both sides of the
     // first row), then each takes its own steps to the same frame times.
     let pair = tmp.join("pair");
-    let o = dda3d(&[
-        os("render"),
-        os("--resume"),
-        ckpt.as_os_str(),
-        os("--compare"),
-        os("penalty"),
-        os("--duration"),
-        os("0.7"),
-        os("--fps"),
-        os("10"),
-        os("--width"),
-        os("320"),
-        os("--height"),
-        os("180"),
-        os("--msaa"),
-        os("1"),
-        os("--quiet"),
-        os("--out"),
-        pair.as_os_str(),
-    ]);
+    let extra = ["--compare", "penalty", "--duration", "0.7", "--fps", "10"];
+    let o = render_resumed(&ckpt, &pair, &extra);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let csv = std::fs::read_to_string(pair.join("frames.csv")).unwrap();
-    let rows: Vec<Vec<String>> = csv
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').map(String::from).collect())
-        .collect();
-    assert_eq!(rows.len(), 3, "{csv}");
-    assert_eq!(
-        (&rows[0][1], &rows[0][2]),
-        (&rows[0][4], &rows[0][5]),
-        "{csv}"
-    );
-    assert_eq!(rows[0][2], steps[0].to_string(), "{csv}");
+    let rows = frame_rows(&pair);
+    assert_eq!(rows.len(), 3, "{rows:?}");
+    assert_eq!((&rows[0][1], &rows[0][2]), (&rows[0][4], &rows[0][5]));
+    assert_eq!(rows[0][2], steps[0].to_string());
     for r in &rows[1..] {
-        assert_eq!(r[1], r[4], "one time on both sides: {csv}");
+        assert_eq!(r[1], r[4], "one time on both sides: {rows:?}");
     }
 }
