@@ -27,16 +27,17 @@
 mod build;
 mod format;
 mod locate;
+mod read;
 mod rock_mass;
 mod write;
 
 use std::fmt;
-use std::io::Read;
 use std::path::Path;
 
 use build::{build_block, check_material, check_overlaps, check_penalty_scale};
 use format::SceneFile;
 use locate::{LineIndex, key_at, key_line, line_of};
+pub(crate) use read::{ReadError, read_bounded};
 
 pub use crate::rockmass::report::RockMassReport;
 pub use write::cut_scene;
@@ -45,7 +46,7 @@ use crate::model::{Block, Model, RockMassOf};
 use crate::params::{JointSetParams, SolverParams, table};
 use crate::physics::geometry::convex_hull;
 use crate::physics::mechanics::Material;
-use crate::text::{one_line, short};
+use crate::text::one_line;
 use rock_mass::CutBlock;
 
 /// The largest scene file read, in bytes (16 MiB). The largest generated wall (99 998 blocks)
@@ -141,7 +142,7 @@ fn read_text(path: &Path) -> Result<(String, String, String), SceneError> {
         line,
         message,
     };
-    let bytes = read_bounded(path, "a scene file").map_err(|m| err(None, m))?;
+    let bytes = read_bounded(path, "a scene file").map_err(|e| err(None, e.to_string()))?;
     let text = String::from_utf8(bytes).map_err(|e| {
         let bytes = e.as_bytes();
         let bad = e.utf8_error().valid_up_to();
@@ -163,44 +164,6 @@ fn read_text(path: &Path) -> Result<(String, String, String), SceneError> {
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "scene".into());
     Ok((text, shown, default_name))
-}
-
-/// The file's bytes, at most [`MAX_FILE_BYTES`] of them. A regular file says its size up front;
-/// a device, pipe or terminal (`/dev/zero`) does not, and is read up to the limit. `kind` names
-/// the file in the message ("a scene file").
-pub(crate) fn read_bounded(path: &Path, kind: &str) -> Result<Vec<u8>, String> {
-    let cannot = |e: std::io::Error| format!("cannot read: {e}");
-    let file = std::fs::File::open(path).map_err(cannot)?;
-    let too_large = |size: &str| {
-        format!(
-            "{size}, more than the limit of {} MiB for {kind}",
-            MAX_FILE_BYTES >> 20
-        )
-    };
-    if let Ok(meta) = file.metadata()
-        && meta.is_file()
-        && meta.len() > MAX_FILE_BYTES
-    {
-        // In MiB, short, unless that rounds to the limit itself.
-        let mib = short(meta.len() as f64 / f64::from(1 << 20));
-        let size = if mib
-            .parse()
-            .is_ok_and(|m: f64| m * f64::from(1 << 20) > MAX_FILE_BYTES as f64)
-        {
-            format!("{mib} MiB")
-        } else {
-            format!("{} bytes", meta.len())
-        };
-        return Err(too_large(&format!("the file is {size}")));
-    }
-    let mut bytes = Vec::new();
-    file.take(MAX_FILE_BYTES + 1)
-        .read_to_end(&mut bytes)
-        .map_err(cannot)?;
-    if bytes.len() as u64 > MAX_FILE_BYTES {
-        return Err(too_large("the input goes on"));
-    }
-    Ok(bytes)
 }
 
 /// The line and message of a toml error: its line from its offset, and the key of the value it
