@@ -30,8 +30,8 @@ pub(super) fn execute(args: &RenderArgs, scene: Scene, spec: &CompareSpec) -> Re
 }
 
 /// `render --resume CHECKPOINT --compare METHOD`: both runs start from the checkpoint's state
-/// `a`, B with its own settings (derived from the checkpoint's) and, where they differ, every
-/// block awake, as a comparison started from a checkpoint in the window does.
+/// `a`, B given its own settings (derived from the checkpoint's) as a comparison started from
+/// a checkpoint in the window is ([`Solver::set_params`]).
 pub(super) fn execute_from(
     args: &RenderArgs,
     a: Solver,
@@ -43,10 +43,7 @@ pub(super) fn execute_from(
         .map_err(|e| Failure::Input(e.to_string()))?;
     let mut b = checkpoint::decode(&checkpoint::encode(&a))
         .map_err(|e| Failure::Failed(format!("the checkpoint's copy for B: {e}")))?;
-    if b.params != params_b {
-        b.wake_all();
-    }
-    b.params = params_b;
+    b.set_params(params_b);
     render_pair(args, a, b, out)
 }
 

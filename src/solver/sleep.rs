@@ -32,7 +32,7 @@ use super::active::Active;
 use super::{Solver, commit, step_control};
 use crate::contact::groups::ContactGroups;
 use crate::contact::record::RecordMap;
-use crate::params::Mode;
+use crate::params::{Mode, SolverParams};
 use crate::physics::integrator::Kinematics;
 use crate::snapshot::{ContactSnapshot, StepStats};
 
@@ -184,6 +184,19 @@ impl Solver {
         self.sleep.wake_all();
     }
 
+    /// Takes `params` in place of its settings, from outside a step (the viewer's panel, a run
+    /// started from a checkpoint with other settings). A change of anything but the end time
+    /// wakes every block: a sleeping island was at rest under the old settings, not
+    /// necessarily under the new.
+    pub fn set_params(&mut self, params: SolverParams) {
+        let mut ends_apart = params.clone();
+        ends_apart.duration = self.params.duration;
+        if ends_apart != self.params {
+            self.wake_all();
+        }
+        self.params = params;
+    }
+
     /// Whether block `i` sleeps.
     pub fn is_asleep(&self, i: usize) -> bool {
         self.sleep.is_asleep(i)
@@ -324,6 +337,28 @@ pub(crate) fn islands(fixed: &[bool], pairs: &[(usize, usize)]) -> Vec<usize> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A cube asleep on its slab stays asleep when only the end time changes, and wakes when
+    /// any other setting does ([`Solver::set_params`]: the panel, a run from a checkpoint).
+    #[test]
+    fn new_settings_wake_the_blocks_and_a_new_end_time_does_not() {
+        let s = crate::scene::parse(crate::solver::CUBE_ON_SLAB, "cube.toml", "cube").unwrap();
+        let mut solver = Solver::new(s.model, s.params);
+        solver.params.duration = 1.0;
+        while !solver.is_asleep(1) && !solver.finished() {
+            solver.step().unwrap();
+        }
+        assert!(solver.is_asleep(1), "the cube falls asleep");
+        let mut p = solver.params.clone();
+        p.duration = 5.0;
+        solver.set_params(p.clone());
+        assert!(solver.is_asleep(1));
+        assert_eq!(solver.params.duration, 5.0);
+        p.joint.friction_angle += 1.0;
+        solver.set_params(p.clone());
+        assert!(!solver.is_asleep(1));
+        assert_eq!(solver.params, p);
+    }
 
     /// Blocks 0–2 a chain on the fixed slab 3; block 4 apart on the slab; block 5 alone.
     fn scene() -> (Vec<bool>, Vec<(usize, usize)>) {

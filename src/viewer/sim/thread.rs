@@ -36,18 +36,15 @@ pub(super) struct Start {
 
 impl Start {
     /// The solver a run starts with, and starts over with on Reset, with `params` (the
-    /// panel's): the model at t = 0, or the checkpoint decoded. Settings other than the
-    /// checkpoint's wake its sleeping blocks, as a change in the panel does. A checkpoint that
-    /// does not decode is an error (checked when the thread starts, so Reset never meets one).
+    /// panel's): the model at t = 0, or the checkpoint decoded and given them as a change in
+    /// the panel is ([`Solver::set_params`]). A checkpoint that does not decode is an error
+    /// (checked when the thread starts, so Reset never meets one).
     fn solver(&self, params: SolverParams) -> Result<Solver, String> {
         let Some(bytes) = self.origin.as_deref() else {
             return Ok(Solver::new(self.model.clone(), params));
         };
         let mut solver = checkpoint::decode(bytes).map_err(|e| e.to_string())?;
-        if solver.params != params {
-            solver.wake_all();
-        }
-        solver.params = params;
+        solver.set_params(params);
         Ok(solver)
     }
 }
@@ -300,14 +297,7 @@ impl Sim {
             }
             Command::SetParams(p) => match p.validate() {
                 Ok(()) => {
-                    // A change of anything but the end time wakes every block: a sleeping
-                    // island was at rest under the old parameters, not necessarily the new.
-                    let mut ends_apart = (*p).clone();
-                    ends_apart.duration = self.solver.params.duration;
-                    if ends_apart != self.solver.params {
-                        self.solver.wake_all();
-                    }
-                    self.solver.params = *p;
+                    self.solver.set_params(*p);
                     // The end time may have moved past or before the current time.
                     match (&self.state, self.solver.finished()) {
                         (RunState::Finished, false) => self.state = RunState::Paused,
