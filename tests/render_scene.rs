@@ -1,8 +1,10 @@
 //! Renders the shipped slope scene (scenes/slope_stable.toml) through the solver: at t = 0, and
 //! after the first step, when its four contacts exist and carry the block's weight.
 
+mod cli_support;
 mod render_support;
 
+use cli_support::{bin, rockfall_checkpoint, tmp};
 use dda3d::render::capture::render_rgba;
 use dda3d::render::mesh::BLOCK_PALETTE_SRGB;
 use dda3d::render::{CaptureOptions, Offscreen};
@@ -149,60 +151,18 @@ fn render_without_an_adapter_is_an_input_error() {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
 
-fn os(s: &str) -> &std::ffi::OsStr {
-    std::ffi::OsStr::new(s)
-}
-
-fn dda3d<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
-    std::process::Command::new(env!("CARGO_BIN_EXE_dda3d"))
-        .args(args)
-        .output()
-        .unwrap()
-}
-
-/// The rockfall run to 0.6 s with a checkpoint at its first step past 0.5 s, in `dir/run`:
-/// the checkpoint's file and time.
-fn rockfall_checkpoint(dir: &std::path::Path) -> (std::path::PathBuf, f64) {
-    let _ = std::fs::remove_dir_all(dir);
-    let scene =
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rock_column_rockfall.toml");
-    let run = dir.join("run");
-    let o = dda3d(&[
-        os("run"),
-        scene.as_os_str(),
-        os("--duration"),
-        os("0.6"),
-        os("--checkpoint-every"),
-        os("0.5"),
-        os("-q"),
-        os("--out"),
-        run.as_os_str(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let ckpt = std::fs::read_dir(&run)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .find(|p| p.extension().is_some_and(|x| x == "ckpt"))
-        .expect("a checkpoint");
-    let t0: f64 = ckpt.file_stem().unwrap().to_str().unwrap()["checkpoint_".len()..]
-        .parse()
-        .unwrap();
-    assert!((0.5..0.6).contains(&t0), "{t0}");
-    (ckpt, t0)
-}
-
 /// `render --resume CKPT` with `extra` flags into `out`, small and quiet.
 fn render_resumed(ckpt: &std::path::Path, out: &std::path::Path, extra: &[&str]) -> Output {
-    let mut args = vec![os("render"), os("--resume"), ckpt.as_os_str()];
-    args.extend(extra.iter().map(|a| os(a)));
-    args.extend(
-        [
-            "--width", "320", "--height", "180", "--msaa", "1", "--quiet",
-        ]
-        .map(os),
-    );
-    args.extend([os("--out"), out.as_os_str()]);
-    dda3d(&args)
+    bin()
+        .args(["render", "--resume"])
+        .arg(ckpt)
+        .args(extra)
+        .args([
+            "--width", "320", "--height", "180", "--msaa", "1", "--quiet", "--out",
+        ])
+        .arg(out)
+        .output()
+        .unwrap()
 }
 
 /// frames.csv's rows, split at the commas.
@@ -219,7 +179,7 @@ fn frame_rows(dir: &std::path::Path) -> Vec<Vec<String>> {
 /// each, exit 2, nothing written; no GPU is needed to say so.
 #[test]
 fn render_from_a_checkpoint_refuses_bad_uses() {
-    let tmp = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_resume_bad");
+    let tmp = tmp("resume_bad");
     let (ckpt, _) = rockfall_checkpoint(&tmp);
     let frames = tmp.join("frames");
     let not_one = tmp.join("run/summary.json");
@@ -248,7 +208,7 @@ fn render_resumes_from_a_checkpoint() {
     if gpu_or_skip("render_resumes_from_a_checkpoint").is_none() {
         return;
     }
-    let tmp = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("render_resume");
+    let tmp = tmp("resume");
     let (ckpt, t0) = rockfall_checkpoint(&tmp);
     let frames = tmp.join("frames");
     let o = render_resumed(&ckpt, &frames, &["--duration", "0.8", "--fps", "10"]);

@@ -2,7 +2,7 @@
 
 #![allow(dead_code)]
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The `dda3d` binary, run from the repository (where the default scenes of `bench` and the
@@ -27,4 +27,35 @@ pub fn tmp(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// The rockfall run to 0.6 s with a checkpoint at its first step past 0.5 s, in `dir/run`:
+/// the checkpoint's file and its time (for `render --resume` and `view --resume`).
+pub fn rockfall_checkpoint(dir: &Path) -> (PathBuf, f64) {
+    let run = dir.join("run");
+    let o = bin()
+        .arg("run")
+        .arg("scenes/rock_column_rockfall.toml")
+        .args([
+            "--duration",
+            "0.6",
+            "--checkpoint-every",
+            "0.5",
+            "-q",
+            "--out",
+        ])
+        .arg(&run)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let ckpt = std::fs::read_dir(&run)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "ckpt"))
+        .expect("a checkpoint");
+    let t0: f64 = ckpt.file_stem().unwrap().to_str().unwrap()["checkpoint_".len()..]
+        .parse()
+        .unwrap();
+    assert!((0.5..0.6).contains(&t0), "{t0}");
+    (ckpt, t0)
 }
