@@ -8,11 +8,10 @@
 //! (set by `.ci/run`) makes that a failure.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
 mod window_support;
 
-use window_support::{distance, finish, have_xvfb_run, skip_or_fail, variation};
+use window_support::{distance, skip_or_fail, variation, view_under_xvfb};
 
 mod cli_support;
 use cli_support::{bin, tmp};
@@ -47,51 +46,23 @@ fn reported_time(line: &str) -> Option<f64> {
 
 #[test]
 fn compare_window_shows_two_different_panes_after_the_impact() {
-    if !have_xvfb_run() {
-        skip_or_fail(
-            "compare view",
-            "xvfb-run is not installed (Debian: apt-get install xvfb xauth)",
-        );
-        return;
-    }
     let dir = tmp("view");
     let png = dir.join("window.png");
-    let runtime = dir.join("xdg");
-    std::fs::create_dir_all(&runtime).unwrap();
-    let child = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1600x900x24"])
-        .arg(env!("CARGO_BIN_EXE_dda3d"))
-        .arg("view")
-        .arg(rockfall())
-        .args([
-            "--compare",
-            "penalty",
-            "--speed",
-            "max",
-            "--size",
-            "1280x720",
-        ])
-        .arg("--screenshot")
-        .arg(&png)
-        .args(["--exit-after-frames", "80"])
-        .arg("--out")
-        .arg(dir.join("out"))
-        .env("XDG_RUNTIME_DIR", &runtime)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start xvfb-run");
-    let (status, stderr) = finish(child);
-    if !status.success() {
-        if stderr.contains("no GPU adapter") {
-            skip_or_fail(
-                "compare view",
-                "no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)",
-            );
-            return;
-        }
-        panic!("viewer failed ({status}):\n{stderr}");
-    }
+    let rockfall = rockfall();
+    let args = [
+        rockfall.as_os_str(),
+        "--compare".as_ref(),
+        "penalty".as_ref(),
+        "--speed".as_ref(),
+        "max".as_ref(),
+        "--size".as_ref(),
+        "1280x720".as_ref(),
+        "--exit-after-frames".as_ref(),
+        "80".as_ref(),
+    ];
+    let Some(stderr) = view_under_xvfb("compare view", &dir, &png, &args) else {
+        return;
+    };
     // Both solvers report, at the same simulated time, after the strike (about 0.2 s).
     let times: Vec<f64> = stderr.lines().filter_map(reported_time).collect();
     assert_eq!(times.len(), 2, "A's and B's report lines:\n{stderr}");

@@ -6,11 +6,10 @@
 //! failure.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
 
 mod window_support;
 
-use window_support::{finish, have_xvfb_run, skip_or_fail, variation};
+use window_support::{variation, view_under_xvfb};
 
 mod cli_support;
 use cli_support::{bin, rockfall_checkpoint, tmp};
@@ -37,45 +36,20 @@ fn contains_color(img: &image::RgbImage, rect: [u32; 4], rgb: [u8; 3], tol: i32)
 
 #[test]
 fn window_screenshot_under_xvfb() {
-    if !have_xvfb_run() {
-        skip_or_fail(
-            "viewer window",
-            "xvfb-run is not installed (Debian: apt-get install xvfb xauth)",
-        );
-        return;
-    }
     let dir = tmp("shot");
     let png = dir.join("window.png");
-    let runtime = dir.join("xdg");
-    std::fs::create_dir_all(&runtime).unwrap();
-    let child = Command::new("xvfb-run")
-        // -a: a free display number, so parallel runs do not collide.
-        .args(["-a", "-s", "-screen 0 1600x900x24"])
-        .arg(env!("CARGO_BIN_EXE_dda3d"))
-        .arg("view")
-        .arg(scene("rock_column_rockfall.toml"))
-        .args(["--size", &format!("{WIDTH}x{HEIGHT}")])
-        .arg("--screenshot")
-        .arg(&png)
-        .args(["--exit-after-frames", "40"])
-        .arg("--out")
-        .arg(dir.join("out"))
-        .env("XDG_RUNTIME_DIR", &runtime)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start xvfb-run");
-    let (status, stderr) = finish(child);
-    if !status.success() {
-        if stderr.contains("no GPU adapter") {
-            skip_or_fail(
-                "viewer window",
-                "no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)",
-            );
-            return;
-        }
-        panic!("viewer failed ({status}):\n{stderr}");
-    }
+    let rockfall = scene("rock_column_rockfall.toml");
+    let size = format!("{WIDTH}x{HEIGHT}");
+    let args = [
+        rockfall.as_os_str(),
+        "--size".as_ref(),
+        size.as_ref(),
+        "--exit-after-frames".as_ref(),
+        "40".as_ref(),
+    ];
+    let Some(stderr) = view_under_xvfb("viewer window", &dir, &png, &args) else {
+        return;
+    };
     assert!(png.exists(), "no screenshot written; stderr:\n{stderr}");
     let img = image::open(&png).expect("a readable PNG").to_rgb8();
     assert_eq!(
@@ -203,37 +177,17 @@ fn the_viewer_opens_at_a_checkpoint() {
         assert!(err.contains(want), "{extra:?}: {err}");
     }
 
-    if !have_xvfb_run() {
-        skip_or_fail(
-            "viewer at a checkpoint",
-            "xvfb-run is not installed (Debian: apt-get install xvfb xauth)",
-        );
-        return;
-    }
-    let runtime = dir.join("xdg");
-    std::fs::create_dir_all(&runtime).unwrap();
     let png = dir.join("window.png");
-    let child = Command::new("xvfb-run")
-        .args(["-a", "-s", "-screen 0 1600x900x24"])
-        .arg(env!("CARGO_BIN_EXE_dda3d"))
-        .args(["view", "--resume"])
-        .arg(&ckpt)
-        .args(["--paused", "--exit-after-frames", "10"])
-        .arg("--screenshot")
-        .arg(&png)
-        .arg("--out")
-        .arg(dir.join("out"))
-        .env("XDG_RUNTIME_DIR", &runtime)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("start xvfb-run");
-    let (status, stderr) = finish(child);
-    if !status.success() && stderr.contains("no GPU adapter") {
-        skip_or_fail("viewer at a checkpoint", "no GPU adapter");
+    let args = [
+        "--resume".as_ref(),
+        ckpt.as_os_str(),
+        "--paused".as_ref(),
+        "--exit-after-frames".as_ref(),
+        "10".as_ref(),
+    ];
+    let Some(stderr) = view_under_xvfb("viewer at a checkpoint", &dir, &png, &args) else {
         return;
-    }
-    assert!(status.success(), "viewer failed ({status}):\n{stderr}");
+    };
     assert!(png.exists(), "no screenshot written; stderr:\n{stderr}");
     // The window opened at the checkpoint's time (src/viewer/sim has the run going on from
     // there, and Reset going back to it).

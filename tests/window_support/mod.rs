@@ -3,6 +3,8 @@
 //! prints a note and passes, unless `DDA3D_REQUIRE_GPU=1` (set by `.ci/run`) makes that a
 //! failure.
 
+use std::ffi::OsStr;
+use std::path::Path;
 use std::process::{Child, Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 
@@ -24,6 +26,50 @@ pub fn have_xvfb_run() -> bool {
         .stderr(Stdio::null())
         .status()
         .is_ok_and(|s| s.success())
+}
+
+/// `dda3d view ARGS --screenshot PNG --out DIR/out` under `xvfb-run` on a 1600×900 screen, with
+/// its own `XDG_RUNTIME_DIR` in `dir`, run to its end: its stderr. `None` where the window
+/// cannot open here (no `xvfb-run`, no GPU adapter): the `test` is skipped with a note, or
+/// fails, as the GPU policy says ([`skip_or_fail`]). A window that fails otherwise panics with
+/// its stderr.
+pub fn view_under_xvfb(test: &str, dir: &Path, png: &Path, args: &[&OsStr]) -> Option<String> {
+    if !have_xvfb_run() {
+        skip_or_fail(
+            test,
+            "xvfb-run is not installed (Debian: apt-get install xvfb xauth)",
+        );
+        return None;
+    }
+    let runtime = dir.join("xdg");
+    std::fs::create_dir_all(&runtime).unwrap();
+    let child = Command::new("xvfb-run")
+        // -a: a free display number, so parallel runs do not collide.
+        .args(["-a", "-s", "-screen 0 1600x900x24"])
+        .arg(env!("CARGO_BIN_EXE_dda3d"))
+        .arg("view")
+        .args(args)
+        .arg("--screenshot")
+        .arg(png)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .env("XDG_RUNTIME_DIR", &runtime)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("start xvfb-run");
+    let (status, stderr) = finish(child);
+    if !status.success() {
+        if stderr.contains("no GPU adapter") {
+            skip_or_fail(
+                test,
+                "no GPU adapter (Debian: apt-get install libvulkan1 mesa-vulkan-drivers)",
+            );
+            return None;
+        }
+        panic!("viewer failed ({status}):\n{stderr}");
+    }
+    Some(stderr)
 }
 
 /// Runs a command to its end (at most 300 s); its status and stderr.
