@@ -167,17 +167,36 @@ fn lock(m: &Mutex<Mailbox>) -> std::sync::MutexGuard<'_, Mailbox> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
+/// What the simulation thread's tests start from: the shipped rockfall, and a checkpoint of it.
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::params::Method;
+mod test_support {
+    use super::Origin;
+    use crate::solver::{Solver, checkpoint};
 
-    fn rockfall() -> crate::scene::Scene {
+    pub fn rockfall() -> crate::scene::Scene {
         let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
             .join("scenes")
             .join("rock_column_rockfall.toml");
         crate::scene::load(&path).expect("shipped scene loads")
     }
+
+    /// The rockfall's solver after `steps` steps, and its checkpoint (`view --resume`).
+    pub fn rockfall_checkpoint(steps: usize) -> (crate::scene::Scene, Solver, Origin) {
+        let s = rockfall();
+        let mut solver = Solver::new(s.model.clone(), s.params.clone());
+        for _ in 0..steps {
+            solver.step().unwrap();
+        }
+        let origin = checkpoint::encode(&solver).into();
+        (s, solver, origin)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_support::{rockfall, rockfall_checkpoint};
+    use super::*;
+    use crate::params::Method;
 
     fn spawn(speed: Speed, play: bool) -> SimHandle {
         let s = rockfall();
@@ -316,13 +335,7 @@ mod tests {
     /// step is the one the checkpoint's solver takes, and Reset goes back to it, not to t = 0.
     #[test]
     fn a_run_from_a_checkpoint_starts_and_resets_there() {
-        use crate::solver::{Solver, checkpoint};
-        let s = rockfall();
-        let mut solver = Solver::new(s.model.clone(), s.params.clone());
-        for _ in 0..20 {
-            solver.step().unwrap();
-        }
-        let origin: Origin = checkpoint::encode(&solver).into();
+        let (s, mut solver, origin) = rockfall_checkpoint(20);
         let at = solver.snapshot();
         solver.step().unwrap();
         let next = solver.snapshot();

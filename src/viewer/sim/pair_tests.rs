@@ -3,13 +3,7 @@
 
 use super::*;
 use crate::compare::CompareSpec;
-
-fn rockfall() -> crate::scene::Scene {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes")
-        .join("rock_column_rockfall.toml");
-    crate::scene::load(&path).expect("shipped scene loads")
-}
+use crate::viewer::sim::test_support::{rockfall, rockfall_checkpoint};
 
 /// The rockfall, A as the scene says (ALM), B with the penalty method.
 fn spawn(speed: Speed, play: bool) -> SimPair {
@@ -124,14 +118,8 @@ fn a_parameter_change_sent_to_b_alone_reaches_b_and_not_a() {
 /// time, move on in lock-step from there, and Reset takes both back to it.
 #[test]
 fn a_comparison_from_a_checkpoint_starts_and_resets_there() {
-    use crate::solver::{Solver, checkpoint};
-    let s = rockfall();
-    let mut solver = Solver::new(s.model.clone(), s.params.clone());
-    for _ in 0..20 {
-        solver.step().unwrap();
-    }
+    let (s, solver, origin) = rockfall_checkpoint(20);
     let t0 = solver.time;
-    let origin: Origin = checkpoint::encode(&solver).into();
     let spec = CompareSpec::parse(Some("penalty"), None).unwrap().unwrap();
     let b = spec.derive(&solver.params).unwrap();
     let params = (solver.params.clone(), b);

@@ -66,11 +66,7 @@ pub fn list(dir: &Path) -> Vec<PathBuf> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn rockfall() -> crate::scene::Scene {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/rock_column_rockfall.toml");
-        crate::scene::load(&path).unwrap()
-    }
+    use crate::viewer::sim::test_support::rockfall;
 
     #[test]
     fn a_saved_state_lists_first_and_loads_back_to_the_same_next_step() {
