@@ -85,8 +85,8 @@ fn render_pair(
 }
 
 /// Steps both solvers to each frame time in turn and submits the pair there, the first frame
-/// (t = 0, or the checkpoint's time) included. Either run's failure ends both early (a half with nothing to show would not
-/// compare); a capture failure is the error.
+/// (t = 0, or the checkpoint's time) included. Either run's failure ends both early (a half
+/// with nothing to show would not compare); a capture failure is the error.
 fn simulate_pairs(
     a: &mut Solver,
     b: &mut Solver,

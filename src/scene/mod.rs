@@ -37,7 +37,7 @@ use std::path::Path;
 use build::{build_block, check_material, check_overlaps, check_penalty_scale};
 use format::SceneFile;
 use locate::{LineIndex, key_at, key_line, line_of};
-pub(crate) use read::{ReadError, read_bounded};
+pub(crate) use read::{ReadError, read_utf8};
 
 pub use crate::rockmass::report::RockMassReport;
 pub use write::cut_scene;
@@ -142,22 +142,9 @@ fn read_text(path: &Path) -> Result<(String, String, String), SceneError> {
         line,
         message,
     };
-    let bytes = read_bounded(path, "a scene file").map_err(|e| err(None, e.to_string()))?;
-    let text = String::from_utf8(bytes).map_err(|e| {
-        let bytes = e.as_bytes();
-        let bad = e.utf8_error().valid_up_to();
-        let line_start = bytes[..bad]
-            .iter()
-            .rposition(|&b| b == b'\n')
-            .map_or(0, |k| k + 1);
-        err(
-            Some(bytes[..bad].iter().filter(|&&b| b == b'\n').count() + 1),
-            format!(
-                "not UTF-8 text: byte 0x{:02x} at column {} (a scene file is TOML, which is UTF-8)",
-                bytes[bad],
-                bad - line_start + 1
-            ),
-        )
+    let text = read_utf8(path, "a scene file").map_err(|e| match e {
+        ReadError::NotUtf8 { line, message } => err(Some(line), message),
+        other => err(None, other.to_string()),
     })?;
     let default_name = path
         .file_stem()

@@ -8,12 +8,13 @@ use std::path::Path;
 use super::MAX_FILE_BYTES;
 use crate::text::short;
 
-/// Why [`read_bounded`] read nothing: the file could not be read, or it is (or goes on)
-/// beyond the limit (the message says how far).
+/// Why [`read_utf8`] read nothing: the file could not be read, it is (or goes on) beyond the
+/// limit (the message says how far), or it is not UTF-8 (the line of the first bad byte).
 #[derive(Debug)]
 pub(crate) enum ReadError {
     Io(std::io::Error),
     TooLarge(String),
+    NotUtf8 { line: usize, message: String },
 }
 
 impl fmt::Display for ReadError {
@@ -21,6 +22,7 @@ impl fmt::Display for ReadError {
         match self {
             ReadError::Io(e) => write!(f, "cannot read: {e}"),
             ReadError::TooLarge(m) => f.write_str(m),
+            ReadError::NotUtf8 { line, message } => write!(f, "line {line}: {message}"),
         }
     }
 }
@@ -28,7 +30,7 @@ impl fmt::Display for ReadError {
 /// The file's bytes, at most [`MAX_FILE_BYTES`] of them. A regular file says its size up front;
 /// a device, pipe or terminal (`/dev/zero`) does not, and is read up to the limit. `kind` names
 /// the file in the message ("a scene file").
-pub(crate) fn read_bounded(path: &Path, kind: &str) -> Result<Vec<u8>, ReadError> {
+fn read_bounded(path: &Path, kind: &str) -> Result<Vec<u8>, ReadError> {
     let file = std::fs::File::open(path).map_err(ReadError::Io)?;
     let too_large = |size: &str| {
         ReadError::TooLarge(format!(
@@ -60,4 +62,25 @@ pub(crate) fn read_bounded(path: &Path, kind: &str) -> Result<Vec<u8>, ReadError
         return Err(too_large("the input goes on"));
     }
     Ok(bytes)
+}
+
+/// The file's text ([`read_bounded`]'s bytes), which must be UTF-8: `kind` is TOML ("a scene
+/// file", "a study file").
+pub(crate) fn read_utf8(path: &Path, kind: &str) -> Result<String, ReadError> {
+    String::from_utf8(read_bounded(path, kind)?).map_err(|e| {
+        let bytes = e.as_bytes();
+        let bad = e.utf8_error().valid_up_to();
+        let line_start = bytes[..bad]
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |k| k + 1);
+        ReadError::NotUtf8 {
+            line: bytes[..bad].iter().filter(|&&b| b == b'\n').count() + 1,
+            message: format!(
+                "not UTF-8 text: byte 0x{:02x} at column {} ({kind} is TOML, which is UTF-8)",
+                bytes[bad],
+                bad - line_start + 1
+            ),
+        }
+    })
 }

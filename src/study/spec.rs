@@ -9,7 +9,7 @@ use super::draw::{self, Distribution};
 use super::keys::{override_scene_text, value_at};
 use super::outcomes::{Outcome, OutcomeSettings, watched};
 use super::{MAX_CASES, Parameter, Study, StudyError};
-use crate::scene::{ReadError, read_bounded, shorten_numbers};
+use crate::scene::{ReadError, read_utf8, shorten_numbers};
 
 /// The outcomes of a study file without `outcomes`: the list (#18) of what a rockfall or
 /// slope study is judged by.
@@ -117,15 +117,9 @@ fn fingerprint(texts: &[&str]) -> String {
 /// A study's or its scene's text, read no further than a scene file may be (`study /dev/zero`
 /// read until memory ran out).
 fn read(path: &Path, kind: &str) -> Result<String, String> {
-    let bytes = read_bounded(path, kind).map_err(|e| match e {
+    read_utf8(path, kind).map_err(|e| match e {
         ReadError::Io(e) => format!("cannot read {}: {e}", path.display()),
-        too_large => too_large.to_string(),
-    })?;
-    String::from_utf8(bytes).map_err(|e| {
-        format!(
-            "not UTF-8 text (byte {} of the file)",
-            e.utf8_error().valid_up_to() + 1
-        )
+        other => other.to_string(),
     })
 }
 
