@@ -252,6 +252,9 @@ pub struct UiState {
     last_notice: u64,
     /// Run B of `view --compare` (None: one run).
     pub compare: Option<Box<super::compare_ui::CompareUi>>,
+    /// The time of the checkpoint the run started from (`view --resume`), where Reset goes
+    /// back to: its equilibrium stage, if any, is behind it.
+    pub resumed_from: Option<f64>,
 }
 
 impl UiState {
@@ -284,6 +287,7 @@ impl UiState {
             out_dir: std::path::PathBuf::from("out"),
             last_notice: 0,
             compare: None,
+            resumed_from: None,
         }
     }
 

@@ -229,6 +229,7 @@ impl Viewer {
         ui.out_dir = opts.out_dir.clone();
         ui.selected = opts.selected;
         ui.compare = sim.compare_ui(&opts);
+        ui.resumed_from = opts.origin.is_some().then_some(first.snapshot.time);
         let view_b = ui.compare.as_mut().map(|c| {
             let v = ViewTarget::new(&gpu, &mut egui.painter, samples);
             c.texture_b = Some(v.id);

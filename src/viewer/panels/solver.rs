@@ -32,7 +32,7 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState) {
             .unwrap_or(1.0),
     };
     let e = &mut state.params.edit;
-    method_and_mode(ui, e);
+    method_and_mode(ui, e, state.resumed_from);
     ui.add_space(4.0);
     egui::Grid::new("params")
         .num_columns(3)
@@ -49,7 +49,7 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState) {
     presets(ui, state);
 }
 
-fn method_and_mode(ui: &mut egui::Ui, e: &mut SolverParams) {
+fn method_and_mode(ui: &mut egui::Ui, e: &mut SolverParams, resumed_from: Option<f64>) {
     ui.horizontal(|ui| {
         param_label(ui, &table::METHOD);
         ui.selectable_value(&mut e.method, Method::Alm, "ALM (DDA-3a)");
@@ -62,8 +62,22 @@ fn method_and_mode(ui: &mut egui::Ui, e: &mut SolverParams) {
     });
     ui.horizontal(|ui| {
         param_label(ui, &table::INITIAL_EQUILIBRIUM);
-        ui.checkbox(&mut e.initial_equilibrium, "")
-            .on_hover_text("Takes effect at Reset: the run restarts with the stage.");
+        match resumed_from {
+            // Reset goes back to the checkpoint, which is past any stage: the box would do
+            // nothing, so it says so instead of seeming to promise a stage.
+            Some(t) => {
+                ui.add_enabled(false, egui::Checkbox::without_text(&mut e.initial_equilibrium))
+                    .on_disabled_hover_text(format!(
+                        "This run started from a checkpoint at t = {}: Reset goes back to \
+                         it, after any stage. Run the scene file to change the stage.",
+                        seconds(t)
+                    ));
+            }
+            None => {
+                ui.checkbox(&mut e.initial_equilibrium, "")
+                    .on_hover_text("Takes effect at Reset: the run restarts with the stage.");
+            }
+        }
     });
 }
 
