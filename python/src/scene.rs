@@ -96,22 +96,17 @@ impl PyScene {
         overrides: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<PyScene> {
         let pairs = override_pairs(py, overrides)?;
-        // The file as `dda3d run` reads it first, for its messages (missing, too large, not UTF-8).
-        let scene = py
-            .detach(|| scene::load(&path))
+        // Read once, as `dda3d run` reads it (its messages: missing, too large, not UTF-8),
+        // then parsed from that text, changed by the overrides if any.
+        let (text, origin, stem) = py
+            .detach(|| scene::read_text(&path))
             .map_err(|e| error(Kind::Scene, e.to_string()))?;
-        let origin = path.display().to_string();
-        let text = std::fs::read_to_string(&path)
-            .map_err(|e| error(Kind::Scene, format!("{origin}: cannot read: {e}")))?;
-        if pairs.is_empty() {
-            return Ok(PyScene {
-                scene,
-                text,
-                origin,
-            });
-        }
-        let stem = default_name(&path);
-        Self::parse(apply(text, &origin, &pairs)?, &origin, &stem)
+        let text = if pairs.is_empty() {
+            text
+        } else {
+            apply(text, &origin, &pairs)?
+        };
+        py.detach(|| Self::parse(text, &origin, &stem))
     }
 
     /// A scene from a dict in the scene file's structure (`{"solver": {"duration": 1.0},

@@ -134,8 +134,8 @@ pub fn load(path: &Path) -> Result<Scene, SceneError> {
 }
 
 /// A scene file's text, with the path as messages show it and the scene's default name (the
-/// file's stem).
-fn read_text(path: &Path) -> Result<(String, String, String), SceneError> {
+/// file's stem): what [`load`] parses, for callers that change the text first.
+pub fn read_text(path: &Path) -> Result<(String, String, String), SceneError> {
     let shown = path.display().to_string();
     let err = |line: Option<usize>, message: String| SceneError {
         path: shown.clone(),
