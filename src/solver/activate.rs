@@ -19,7 +19,7 @@ use crate::contact::law;
 use crate::contact::record::{ContactRecord, RecordMap};
 use crate::contact::{Candidate, ContactKey, ContactState, DetectionParams, Shape};
 use crate::model::Block;
-use crate::params::{Method, SolverParams};
+use crate::params::{Method, Mode, SolverParams};
 use crate::physics::geometry::{Vec3, planar_hull_area};
 
 /// What activation reads.
@@ -191,12 +191,18 @@ fn activate_one(
     keep_overlap(inp, &cand, &mut rec, &mut kin.d0, unseen, w0);
     // The force the last step ended with, under the warm start (a new record's is 0).
     let friction_normal = initial_friction_normal(p, &rec);
+    let mass = lighter_mass(bi, bj);
     let active = Active {
         joint: joint_set(&cand.key, bi, bj),
         kin,
         alt_kin,
         young: bi.material.young_modulus.min(bj.material.young_modulus),
         weight: lighter_weight(bi, bj, p),
+        inertia: if p.mode == Mode::Dynamic && mass.is_finite() {
+            2.0 * mass / (p.max_time_step * p.max_time_step)
+        } else {
+            0.0
+        },
         w0,
         start: rec,
         rec,
@@ -225,9 +231,14 @@ fn activate_one(
 /// The weight of the lighter of two blocks, a fixed block not counted, N.
 fn lighter_weight(bi: &Block, bj: &Block, p: &SolverParams) -> f64 {
     let g = Vec3::from(p.gravity).norm();
-    let mass = |b: &Block| if b.fixed { f64::INFINITY } else { b.mass };
-    let m = mass(bi).min(mass(bj));
+    let m = lighter_mass(bi, bj);
     if m.is_finite() { m * g } else { 0.0 }
+}
+
+/// The mass of the lighter free block of the two, kg; infinite where both are fixed.
+fn lighter_mass(bi: &Block, bj: &Block) -> f64 {
+    let mass = |b: &Block| if b.fixed { f64::INFINITY } else { b.mass };
+    mass(bi).min(mass(bj))
 }
 
 /// The record of a contact seen for the first time: closed (locked) if it is touching or

@@ -38,6 +38,9 @@ pub(crate) struct Active {
     /// The weight of the lighter free block of the two, N: the scale of a shear spring's
     /// force below which [`Active::cap_shear`] leaves it alone.
     pub weight: f64,
+    /// 2m/Δt_max² of that block in dynamic mode (0 in static mode, or both fixed), N/m: where
+    /// it exceeds α·p_n,1, p_τ may follow p_n up to it ([`ContactParams::shear_penalty`]).
+    pub inertia: f64,
     /// The joint set the contact lies on (`None`: `[joint]`); see [`SolverParams::joint_of`].
     pub joint: Option<u16>,
     /// Shi's w0 of the contact's group (`crate::contact::groups`), m: the length its
@@ -262,7 +265,8 @@ impl Active {
     /// its extension is scaled by the inverse ratio (shortened as (P21) raises p_n, stretched as
     /// [`Active::release_tension`] lowers it), and no energy is created.
     pub fn set_penalty(&mut self, penalty: f64, cp: &ContactParams) {
-        let ratio = cp.shear_penalty(self.rec.penalty) / cp.shear_penalty(penalty);
+        let ratio = cp.shear_penalty(self.rec.penalty, self.inertia)
+            / cp.shear_penalty(penalty, self.inertia);
         let delta = self.cand.xa - self.rec.reference;
         self.rec.reference = self.cand.xa - delta * ratio;
         self.rec.penalty = penalty;
@@ -274,7 +278,7 @@ impl Active {
     /// downhill step by step (issue #12).
     pub fn stick(&mut self, p: &SolverParams) {
         let friction = self.sliding_friction(p);
-        let p_tau = p.contact.shear_penalty(self.rec.penalty);
+        let p_tau = p.contact.shear_penalty(self.rec.penalty, self.inertia);
         self.rec.state = ContactState::Lock;
         self.rec.reference = self.cand.xb - self.rec.tau * (friction / p_tau);
     }
@@ -292,7 +296,7 @@ impl Active {
         let n = self.cand.normal;
         let r = self.cand.xa - self.rec.reference;
         let along = r - n * n.dot(&r);
-        let p_tau = p.contact.shear_penalty(self.rec.penalty);
+        let p_tau = p.contact.shear_penalty(self.rec.penalty, self.inertia);
         let strength = (SHEAR_CAP
             * (self.force.max(self.rec.lambda).max(0.0) * self.tan_phi(p) + self.cohesion(p)))
         .max(self.weight);
@@ -308,7 +312,7 @@ impl Active {
     /// locked. DDA-3p keeps Shi's friction, a load alone.
     pub fn set_lateral(&mut self, p: &SolverParams, slip: f64) {
         self.lateral = if p.method == Method::Alm && self.rec.state == ContactState::Slide {
-            let p_tau = p.contact.shear_penalty(self.rec.penalty);
+            let p_tau = p.contact.shear_penalty(self.rec.penalty, self.inertia);
             let friction = self.sliding_friction(p);
             if friction < p_tau * slip {
                 friction / slip

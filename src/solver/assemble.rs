@@ -183,7 +183,7 @@ fn add_contact_stiffness<'m>(
         add_normal_stiffness_block(m, which, &c.kin, key.penalty);
         match &tangential {
             Tangential::Spring(tb) => {
-                let p_tau = cp.shear_penalty(key.penalty);
+                let p_tau = cp.shear_penalty(key.penalty, c.inertia);
                 add_shear_spring_stiffness_block(m, which, &ta, tb, n, p_tau);
             }
             Tangential::Friction(tb) => {
@@ -225,7 +225,7 @@ pub(crate) fn contact_forces(p: &SolverParams, blocks: &[Block], c: &Active) -> 
     match c.rec.state {
         ContactState::Lock => {
             let delta = c.cand.xa - c.rec.reference;
-            let p_tau = p.contact.shear_penalty(c.rec.penalty);
+            let p_tau = p.contact.shear_penalty(c.rec.penalty, c.inertia);
             add_shear_spring_force(&mut t, &c.ta(blocks), &tb, &c.cand.normal, &delta, p_tau);
         }
         ContactState::Slide => {

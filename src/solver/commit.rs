@@ -68,7 +68,7 @@ fn commit_contact(
         rec.normal_force = c.force;
         let (magnitude, direction) = match rec.state {
             ContactState::Lock => (
-                p.contact.shear_penalty(rec.penalty) * c.shear.norm(),
+                p.contact.shear_penalty(rec.penalty, c.inertia) * c.shear.norm(),
                 -c.shear.try_normalize(0.0).unwrap_or_else(Vec3::zeros),
             ),
             _ => {

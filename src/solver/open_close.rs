@@ -130,7 +130,7 @@ fn lower_sign(c: &Active) -> f64 {
 /// lower-numbered block, N.
 fn spring_force_on_lower(inp: &CheckInputs, d: &[f64], c: &Active) -> Vec3 {
     let extension = c.spring_extension(&c.relative_displacement(d, inp.blocks));
-    extension * (inp.params.contact.shear_penalty(c.rec.penalty) * lower_sign(c))
+    extension * (inp.params.contact.shear_penalty(c.rec.penalty, c.inertia) * lower_sign(c))
 }
 
 /// Classifies every contact from the solution `d` and applies the verdicts. Returns whether a
@@ -280,7 +280,7 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
 /// iterated too, the slice of that slope in `tests/joint_sets.rs` let a block of its stable
 /// mass move 17 mm in 1 s (0.13 mm as it is) and a free block fall 9 % short.
 fn softens(inp: &CheckInputs, c: &Active) -> bool {
-    let p_tau = inp.params.contact.shear_penalty(c.rec.penalty);
+    let p_tau = inp.params.contact.shear_penalty(c.rec.penalty, c.inertia);
     law::fine_range(c.force, p_tau, &c.law(inp.params), 1.0)
 }
 
@@ -302,7 +302,7 @@ fn classify(inp: &CheckInputs, c: &mut Active, du: &Vec3) -> (Transition, Vec3) 
         penetration: c.dn,
         normal_force: c.force,
         shear,
-        shear_stiffness: cp.shear_penalty(c.rec.penalty),
+        shear_stiffness: cp.shear_penalty(c.rec.penalty, c.inertia),
         cohesion: if c.rec.intact && inp.holding.contains(&pair_key(c)) {
             f64::INFINITY
         } else {

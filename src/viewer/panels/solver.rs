@@ -66,12 +66,15 @@ fn method_and_mode(ui: &mut egui::Ui, e: &mut SolverParams, resumed_from: Option
             // Reset goes back to the checkpoint, which is past any stage: the box would do
             // nothing, so it says so instead of seeming to promise a stage.
             Some(t) => {
-                ui.add_enabled(false, egui::Checkbox::without_text(&mut e.initial_equilibrium))
-                    .on_disabled_hover_text(format!(
-                        "This run started from a checkpoint at t = {}: Reset goes back to \
+                ui.add_enabled(
+                    false,
+                    egui::Checkbox::without_text(&mut e.initial_equilibrium),
+                )
+                .on_disabled_hover_text(format!(
+                    "This run started from a checkpoint at t = {}: Reset goes back to \
                          it, after any stage. Run the scene file to change the stage.",
-                        seconds(t)
-                    ));
+                    seconds(t)
+                ));
             }
             None => {
                 ui.checkbox(&mut e.initial_equilibrium, "")
