@@ -34,8 +34,12 @@ pub fn cut(args: &CutArgs) -> Result<(), CliError> {
         args.scene.with_file_name(format!("{stem}_cut.toml"))
     });
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| CliError::Run(format!("{}: {e}", dir.display())))?;
+        crate::output::create_dir_clearly(dir).map_err(|e| {
+            CliError::Run(format!(
+                "{}: cannot create the output directory: {e}",
+                dir.display()
+            ))
+        })?;
     }
     std::fs::write(&out, text).map_err(|e| CliError::Run(format!("{}: {e}", out.display())))?;
     for r in &reports {

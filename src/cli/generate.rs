@@ -55,8 +55,12 @@ pub fn generate(args: &GenerateArgs) -> Result<(), CliError> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("column_{}.toml", args.blocks)));
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir)
-            .map_err(|e| CliError::Run(format!("{}: {e}", dir.display())))?;
+        crate::output::create_dir_clearly(dir).map_err(|e| {
+            CliError::Run(format!(
+                "{}: cannot create the output directory: {e}",
+                dir.display()
+            ))
+        })?;
     }
     std::fs::write(&out, text).map_err(|e| CliError::Run(format!("{}: {e}", out.display())))?;
     eprintln!("wrote {}", out.display());

@@ -66,7 +66,12 @@ pub fn write_plots(
 ) -> Result<Vec<PathBuf>, String> {
     check_lengths(parameters, outcomes)?;
     let plots = dir.join("plots");
-    fs::create_dir_all(&plots).map_err(|e| format!("cannot create {}: {e}", plots.display()))?;
+    crate::output::create_dir_clearly(&plots).map_err(|e| {
+        format!(
+            "{}: cannot create the output directory: {e}",
+            plots.display()
+        )
+    })?;
     let mut written = Vec::new();
     for (name, (o, p)) in pair_file_names(parameters, outcomes) {
         let png = single_plot(&parameters[p], &outcomes[o])?;

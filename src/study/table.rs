@@ -28,8 +28,12 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), StudyError> {
 /// Creates `out` and `out/cases`.
 pub fn create_dirs(out: &Path) -> Result<(), StudyError> {
     let dir = cases_dir(out);
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| StudyError::io(format!("{}: cannot create: {e}", dir.display())))
+    crate::output::create_dir_clearly(&dir).map_err(|e| {
+        StudyError::io(format!(
+            "{}: cannot create the output directory: {e}",
+            dir.display()
+        ))
+    })
 }
 
 /// Writes a finished case's record, atomically: a killed study loses only the cases in flight.

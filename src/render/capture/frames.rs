@@ -78,7 +78,7 @@ pub fn render_to_png(
     let mut off = Offscreen::with_max_samples(gpu, opts.width, opts.height, opts.max_msaa_samples)?;
     let (rgba, camera) = render_rgba(&mut off, snapshot, opts)?;
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| RenderError::io(dir, e))?;
+        super::create_output_dir(dir)?;
     }
     write_png(path, &rgba, opts.width, opts.height, opts.style.transparent)?;
     Ok(camera)

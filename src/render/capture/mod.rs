@@ -42,6 +42,13 @@ pub use encode::{unpremultiply, write_png};
 pub use frames::{render_rgba, render_to_png};
 pub use options::{CaptureOptions, Framing};
 
+/// Creates a directory the capture writes into, and its parents: a file in the way is named
+/// ([`crate::output::create_dir_clearly`]), as `run` names it.
+pub(crate) fn create_output_dir(dir: &Path) -> Result<(), RenderError> {
+    crate::output::create_dir_clearly(dir)
+        .map_err(|e| RenderError::io(dir, format!("cannot create the output directory: {e}")))
+}
+
 /// First error of any worker thread, shared by all of them.
 type Failure = Arc<Mutex<Option<RenderError>>>;
 /// A worker thread: its result is its busy time (or statistics), or why it stopped.
@@ -142,7 +149,7 @@ impl FrameCapture {
         opts: CaptureOptions,
         started: Instant,
     ) -> Result<FrameCapture, RenderError> {
-        std::fs::create_dir_all(&opts.out_dir).map_err(|e| RenderError::io(&opts.out_dir, e))?;
+        create_output_dir(&opts.out_dir)?;
         let adapter = gpu.adapter_summary();
         // A side-by-side frame is two half-width pictures of the same size and camera.
         let (w, halves) = match &opts.sides {

@@ -103,7 +103,7 @@ impl Capture {
             .spawn(move || {
                 let r = (|| {
                     if let Some(dir) = path.parent() {
-                        std::fs::create_dir_all(dir).map_err(|e| RenderError::io(dir, e))?;
+                        crate::render::capture::create_output_dir(dir)?;
                     }
                     let mut off = Offscreen::new(gpu, w, h)?;
                     let rgba = off.render(&scene, &camera)?;

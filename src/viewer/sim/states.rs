@@ -11,8 +11,13 @@ use crate::solver::checkpoint::{self, EXTENSION};
 /// Writes the solver's state to `dir/checkpoint_<t>.ckpt`. Returns the message for the window.
 pub fn save(solver: &Solver, dir: &Path) -> Result<String, String> {
     let path = dir.join(checkpoint::file_name(solver.time));
-    std::fs::create_dir_all(dir)
-        .and_then(|()| checkpoint::save(solver, &path))
+    crate::output::create_dir_clearly(dir).map_err(|e| {
+        format!(
+            "{}: cannot save the state: cannot create its directory: {e}",
+            dir.display()
+        )
+    })?;
+    checkpoint::save(solver, &path)
         .map_err(|e| format!("{}: cannot save the state: {e}", path.display()))?;
     Ok(format!("state saved to {}", path.display()))
 }
