@@ -84,6 +84,21 @@ fn wrong_values_and_incomplete_tables_are_named() {
         err.contains("line 9: blocks[1]: missing field `material`"),
         "{err}"
     );
+    // A key given twice is named with its table (before: "line 4: duplicate key").
+    let twice = format!(
+        "[solver]\nduration = 1.0\nmax_time_step = 0.01\nduration = 2.0\n{}",
+        scene("")
+    );
+    let err = run_error(&dir, &twice, "a key twice");
+    assert!(
+        err.ends_with("bad.toml: line 4: solver.duration: duplicate key\n"),
+        "{err}"
+    );
+    let err = run_error(&dir, &scene("name = \"b\"\n"), "a block's key twice");
+    assert!(
+        err.ends_with("line 9: blocks[0].name: duplicate key\n"),
+        "{err}"
+    );
 }
 
 /// Lists of the wrong length, in every field that takes one.

@@ -92,6 +92,54 @@ fn find_value(table: &DeTable<'_>, offset: usize, prefix: &str) -> Option<String
     None
 }
 
+/// The key that stands in for the repeated one in [`duplicate_key`]'s probe.
+const PROBE: &str = "dda3d_duplicate_key_probe";
+
+/// The dotted key of a "duplicate key" error, whose span is the repeated name as written:
+/// `solver.duration`, `blocks[1].name`, `a.b` for a dotted key, `solver.contact` for a table
+/// header given twice. toml's message names no key. The text up to the repeated line, with a
+/// probe key in place of that line's key, parses (the repetition is not in it) and says which
+/// table the line is in; where it does not (a key repeated inside an inline table), the name
+/// as written.
+pub(super) fn duplicate_key(text: &str, span: std::ops::Range<usize>) -> String {
+    let Some(written) = text.get(span.clone()) else {
+        return String::new();
+    };
+    let written = written.trim().trim_matches(['"', '\'']);
+    let line_start = text[..span.start].rfind('\n').map_or(0, |k| k + 1);
+    let before = &text[line_start..span.start];
+    if let Some(header) = before.trim_start().strip_prefix('[') {
+        return format!("{}{written}", header.trim_start_matches('[').trim_start());
+    }
+    let dotted_prefix = before
+        .chars()
+        .all(|c| c.is_alphanumeric() || "_-. \t".contains(c));
+    let table = dotted_prefix
+        .then(|| format!("{}{before}{PROBE} = 0\n", &text[..line_start]))
+        .and_then(|probe| probe_table(DeTable::parse(&probe).ok()?.get_ref(), ""));
+    format!("{}{written}", table.unwrap_or_default())
+}
+
+/// The dotted prefix (`solver.`, `blocks[1].`) of the table that holds [`PROBE`]: the probe is
+/// the last key of its text, so in an array of tables it is in the last one.
+fn probe_table(table: &DeTable<'_>, prefix: &str) -> Option<String> {
+    table.iter().find_map(|(name, value)| {
+        let key = name.get_ref();
+        if key == PROBE {
+            return Some(prefix.to_owned());
+        }
+        match value.get_ref() {
+            DeValue::Table(t) => probe_table(t, &format!("{prefix}{key}.")),
+            DeValue::Array(items) => {
+                let k = items.len().checked_sub(1)?;
+                let t = items[k].get_ref().as_table()?;
+                probe_table(t, &format!("{prefix}{key}[{k}]."))
+            }
+            _ => None,
+        }
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,6 +176,29 @@ mod tests {
             key_at(header, header.rfind("[[").unwrap()).as_deref(),
             Some("blocks[1]")
         );
+        let dup = |text: &str| {
+            let e = toml::from_str::<toml::Table>(text).unwrap_err();
+            assert_eq!(e.message(), "duplicate key", "{text}");
+            duplicate_key(text, e.span().unwrap())
+        };
+        assert_eq!(
+            dup("[solver]\nduration = 1\nduration = 2\n"),
+            "solver.duration"
+        );
+        assert_eq!(
+            dup("[solver]\nduration = 1\n\"duration\" = 2\n"),
+            "solver.duration"
+        );
+        assert_eq!(
+            dup("[[blocks]]\nname = \"a\"\n[[blocks]]\nname = \"b\"\nname = \"c\"\n"),
+            "blocks[1].name"
+        );
+        assert_eq!(dup("x = 1\na.b = 1\na.b = 2\n"), "a.b");
+        assert_eq!(
+            dup("[solver.contact]\nbeta = 1\n[solver.contact]\n"),
+            "solver.contact"
+        );
+        assert_eq!(dup("[solver]\nx = { y = 1, y = 2 }\n"), "y");
         assert_eq!(line_of("a\nb\nc", 4), 3);
         assert_eq!(line_of("a", 99), 1);
         let text = "a\nbb\n\nccc\n";

@@ -161,6 +161,13 @@ fn toml_error(text: &str, e: &toml::de::Error) -> (Option<usize>, String) {
         return (None, message);
     };
     let line = Some(line_of(text, span.start));
+    if message == "duplicate key" {
+        let key = locate::duplicate_key(text, span);
+        if !key.is_empty() {
+            return (line, format!("{key}: {message}"));
+        }
+        return (line, message);
+    }
     match key_at(text, span.start) {
         Some(key) if !message.contains(&format!("`{key}`")) => (line, format!("{key}: {message}")),
         _ => (line, message),
