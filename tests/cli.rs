@@ -142,6 +142,45 @@ fn missing_file_and_bad_flags_exit_2() {
     assert_eq!(out.status.code(), Some(2));
 }
 
+/// A first argument that is no subcommand but a path, as a mistyped scene file of the shorthand
+/// `dda3d SCENE.toml` is, says what is wrong with the file (before: clap's "unrecognized
+/// subcommand"); a word that is no path is still clap's usage error.
+#[test]
+fn a_mistyped_scene_path_is_named() {
+    for (arg, expected) in [
+        (
+            "scenes/slope_sliding.tom",
+            "error: scenes/slope_sliding.tom: no such scene file",
+        ),
+        ("scenes/", "error: scenes/: not a file"),
+        (
+            "Cargo.lock",
+            "error: Cargo.lock: not a scene file (a scene file's name ends in .toml; `dda3d view \
+             Cargo.lock` opens it as one)",
+        ),
+        ("frobnicate", "error: unrecognized subcommand 'frobnicate'"),
+    ] {
+        let out = bin().arg(arg).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{arg}: {err}");
+        assert_eq!(err.trim_end(), expected, "{arg}");
+    }
+}
+
+/// A study file that cannot be read is named once (before: "nosuch.toml: cannot read
+/// nosuch.toml: …").
+#[test]
+fn a_missing_study_file_is_named_once() {
+    let out = bin().args(["study", "nosuch.toml"]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.starts_with("error: nosuch.toml: cannot read: No such file"),
+        "{err}"
+    );
+    assert_eq!(err.matches("nosuch.toml").count(), 1, "{err}");
+}
+
 #[test]
 fn touching_blocks_are_accepted() {
     let dir = tmp("touch");

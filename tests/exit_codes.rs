@@ -378,3 +378,37 @@ fn a_standard_stream_that_cannot_be_written_is_an_io_error() {
         .unwrap();
     assert_eq!(out.status.code(), Some(i32::from(Status::Io.code())));
 }
+
+/// `--help` and `--version` to a stream that cannot be written end as every other command's
+/// output does: status 74 and one line (clap's own exit ignored the failure and exited 0).
+#[test]
+fn help_and_version_to_a_full_stdout_are_io_errors() {
+    for args in [
+        &["--help"][..],
+        &["run", "--help"],
+        &["--version"],
+        &["help"],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_dda3d"))
+            .args(args)
+            .stdout(
+                std::fs::OpenOptions::new()
+                    .write(true)
+                    .open("/dev/full")
+                    .unwrap(),
+            )
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(
+            out.status.code(),
+            Some(i32::from(Status::Io.code())),
+            "{args:?}: {err}"
+        );
+        assert!(
+            err.starts_with("error: failed printing to stdout: No space left on device"),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+    }
+}

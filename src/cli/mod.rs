@@ -240,11 +240,20 @@ pub fn main_entry() -> ExitCode {
 }
 
 /// The process's command line, parsed. A usage error is one line on stderr (clap's message,
-/// its tip in brackets, without the usage block) and exit status 2; `--help` and `--version`
-/// print as clap prints them.
+/// its tip in brackets, without the usage block) and exit status 2, as is a first argument that
+/// is no subcommand but a path (a scene file's name mistyped in `dda3d SCENE.toml`); `--help`
+/// and `--version` print as clap prints them, and a failure to print them is an I/O error
+/// (status 74), as it is for every other command.
 fn parse_command_line() -> Cli {
-    match Cli::try_parse_from(expand_scene_shorthand(std::env::args_os().collect())) {
+    let args = expand_scene_shorthand(std::env::args_os().collect());
+    match Cli::try_parse_from(&args) {
         Ok(cli) => cli,
+        Err(e) if e.kind() == ErrorKind::InvalidSubcommand => {
+            let line = args.get(1).and_then(|a| not_a_scene(a));
+            let line = line.unwrap_or_else(|| one_line_usage_error(&e.render().to_string()));
+            eprintln!("{line}");
+            std::process::exit(e.exit_code());
+        }
         Err(e)
             if e.use_stderr()
                 && e.kind() != ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand =>
@@ -252,8 +261,43 @@ fn parse_command_line() -> Cli {
             eprintln!("{}", one_line_usage_error(&e.render().to_string()));
             std::process::exit(e.exit_code());
         }
-        Err(e) => e.exit(),
+        Err(e) => print_help_or_version(&e),
     }
+}
+
+/// Prints clap's help or version text and exits with clap's status; where the stream cannot
+/// be written (`dda3d --help > /dev/full`), exits with [`exit::Status::Io`] and the line the
+/// other commands give (clap's own `exit` ignores the failure and exits 0).
+fn print_help_or_version(e: &clap::Error) -> ! {
+    use std::io::Write;
+    let (stream, printed) = if e.use_stderr() {
+        ("stderr", e.print().and_then(|()| std::io::stderr().flush()))
+    } else {
+        ("stdout", e.print().and_then(|()| std::io::stdout().flush()))
+    };
+    if let Err(w) = printed {
+        let _ = writeln!(std::io::stderr(), "error: failed printing to {stream}: {w}");
+        std::process::exit(i32::from(exit::Status::Io.code()));
+    }
+    std::process::exit(e.exit_code());
+}
+
+/// The error for a first argument that is no subcommand but looks like a path (a `/` or a `.`
+/// in it): a scene file whose name was mistyped in the shorthand `dda3d SCENE.toml`, which
+/// clap called an unrecognized subcommand. None for anything else.
+fn not_a_scene(arg: &std::ffi::OsStr) -> Option<String> {
+    let text = arg.to_string_lossy();
+    if !(text.contains('/') || text.contains('.')) {
+        return None;
+    }
+    Some(match std::fs::metadata(arg) {
+        Err(_) => format!("error: {text}: no such scene file"),
+        Ok(m) if !m.is_file() => format!("error: {text}: not a file"),
+        Ok(_) => format!(
+            "error: {text}: not a scene file (a scene file's name ends in .toml; `dda3d view \
+             {text}` opens it as one)"
+        ),
+    })
 }
 
 /// clap's rendered error as one line: the lines before `Usage:`, joined, with a `tip:` in

@@ -114,8 +114,8 @@ fn fingerprint(texts: &[&str]) -> String {
     format!("{h:016x}")
 }
 
-/// A study's or its scene's text, read no further than a scene file may be (`study /dev/zero`
-/// read until memory ran out).
+/// A study's scene's text, read no further than a scene file may be (`study /dev/zero` read
+/// until memory ran out). A failure to read names the scene: the line names the study file.
 fn read(path: &Path, kind: &str) -> Result<String, String> {
     read_utf8(path, kind).map_err(|e| match e {
         ReadError::Io(e) => format!("cannot read {}: {e}", path.display()),
@@ -129,7 +129,8 @@ pub(super) fn load(path: &Path) -> Result<Study, StudyError> {
     // Numbers short, as a scene file's errors have them (`toppled_angle = 1e300`, not 301
     // digits).
     let fail = |m: String| StudyError::input(format!("{shown}: {}", shorten_numbers(&m)));
-    let text = read(path, "a study file").map_err(fail)?;
+    // The study file is named at the start of the line already: not twice.
+    let text = read_utf8(path, "a study file").map_err(|e| fail(e.to_string()))?;
     let file: StudyFile = toml::from_str(&text).map_err(|e| {
         let line = e
             .span()
