@@ -43,9 +43,9 @@ pub struct RenderArgs {
     /// Frames per second of simulated time.
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     pub fps: f64,
-    #[arg(long, default_value_t = 1280)]
+    #[arg(long, default_value_t = 1280, allow_negative_numbers = true)]
     pub width: u32,
-    #[arg(long, default_value_t = 720)]
+    #[arg(long, default_value_t = 720, allow_negative_numbers = true)]
     pub height: u32,
     /// Camera azimuth and elevation in degrees, and optionally distance in m: `az,el[,dist]`.
     #[arg(long, allow_hyphen_values = true)]
@@ -68,7 +68,7 @@ pub struct RenderArgs {
     pub no_arrows: bool,
     /// Arrows at the N contacts with the largest normal force only, or `all` (default: the
     /// strongest 500; the legend says when some are left out).
-    #[arg(long, value_name = "N|all")]
+    #[arg(long, value_name = "N|all", allow_negative_numbers = true)]
     pub arrows: Option<String>,
     /// Transparent background.
     #[arg(long)]
@@ -80,7 +80,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub gif: bool,
     /// Antialiasing samples (1 or 4).
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
     pub msaa: u32,
     #[arg(long, short)]
     pub quiet: bool,
@@ -465,6 +465,34 @@ mod tests {
             ArrowMode::None
         );
         assert!(options(&["--normals", "--no-arrows"]).is_err());
+    }
+
+    /// A negative number is a value of its flag, which its own check answers (before: clap's
+    /// tip "to pass '-3' as a value, use '-- -3'", for flags that take no such value); the
+    /// camera's messages name the flag once.
+    #[test]
+    fn negative_numbers_and_bad_cameras_get_their_flags_message() {
+        let err = options(&["--arrows", "-3"]).unwrap_err();
+        assert!(
+            err.contains("--arrows takes a positive count or `all`, got \\\"-3\\\""),
+            "{err}"
+        );
+        for flag in ["--width", "--height", "--msaa"] {
+            let err = options(&[flag, "-3"]).unwrap_err();
+            assert!(err.contains("invalid value '-3'"), "{flag}: {err}");
+            assert!(!err.contains("-- -3"), "{flag}: {err}");
+        }
+        let err = options(&["--camera", "30"]).unwrap_err();
+        assert!(
+            err.contains("\"--camera: expects az,el or az,el,dist"),
+            "{err}"
+        );
+        assert_eq!(err.matches("--camera").count(), 1, "{err}");
+        let err = options(&["--camera", "30,x"]).unwrap_err();
+        assert!(
+            err.contains("\"--camera: elevation \\\"x\\\" is not a number"),
+            "{err}"
+        );
     }
 
     /// From t = 0 the frames after the first are 1..=⌊duration·fps⌋, as before `--resume`;

@@ -22,14 +22,14 @@ pub struct StudyArgs {
     /// Study file (TOML): the base scene, the keys varied, the outcomes.
     pub study: PathBuf,
     /// Cases run at once (default: the available cores).
-    #[arg(long, short = 'j', value_name = "N")]
+    #[arg(long, short = 'j', value_name = "N", allow_negative_numbers = true)]
     pub jobs: Option<usize>,
     /// Output directory (default: out/<study file name as a slug>).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Run case K (0-based) alone, write its record and print its row; exit status 1 if it
     /// failed. The next full run assembles it.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", allow_negative_numbers = true)]
     pub case: Option<usize>,
     /// With --case K: write case K's scene (the base scene with its values set) to FILE and
     /// run nothing, to watch or rerun the case with `dda3d view FILE` / `dda3d run FILE`.

@@ -35,7 +35,7 @@ pub struct ViewArgs {
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     pub size: (u32, u32),
     /// Simulation speed: a real-time factor (1 = real time, 0.1 = slow motion) or `max`.
-    #[arg(long, default_value = "1", value_parser = parse_speed)]
+    #[arg(long, default_value = "1", value_parser = parse_speed, allow_negative_numbers = true)]
     pub speed: Speed,
     /// Open paused at t = 0 instead of running.
     #[arg(long)]
@@ -46,11 +46,11 @@ pub struct ViewArgs {
     pub screenshot: Option<PathBuf>,
     /// Render this many frames, then exit with status 0 (with --screenshot: write it first).
     /// Prints the frame time and solver speed on exit.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub exit_after_frames: Option<u64>,
     /// MSAA samples of the 3-D view (1 or 4). Default: 4 on a GPU, 1 on a software
     /// rasterizer, where 4× costs about three times as much per frame.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub msaa: Option<u32>,
     /// Directory for the screenshot button and recordings (default: out/<scene name>).
     #[arg(long)]

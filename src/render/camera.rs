@@ -287,19 +287,20 @@ pub struct CameraOverride {
 }
 
 impl CameraOverride {
-    /// Parses `az,el` or `az,el,dist` (degrees, degrees, metres), as given to `--camera`.
+    /// Parses `az,el` or `az,el,dist` (degrees, degrees, metres), as given to `--camera`. The
+    /// messages do not name the flag: the command line puts `--camera: ` before them.
     pub fn parse(text: &str) -> Result<CameraOverride, String> {
         let parts: Vec<&str> = text.split(',').map(str::trim).collect();
         if !(2..=3).contains(&parts.len()) {
             return Err(format!(
-                "--camera expects az,el or az,el,dist (degrees, degrees, metres), got {text:?}"
+                "expects az,el or az,el,dist (degrees, degrees, metres), got {text:?}"
             ));
         }
         let num = |s: &str, what: &str| -> Result<f32, String> {
             s.parse::<f32>()
                 .ok()
                 .filter(|v| v.is_finite())
-                .ok_or_else(|| format!("--camera: {what} {s:?} is not a number"))
+                .ok_or_else(|| format!("{what} {s:?} is not a number"))
         };
         let mut o = CameraOverride {
             azimuth_deg: Some(num(parts[0], "azimuth")?),
@@ -309,7 +310,7 @@ impl CameraOverride {
         if let Some(d) = parts.get(2) {
             let d = num(d, "distance")?;
             if d <= 0.0 {
-                return Err(format!("--camera: distance must be positive, got {d}"));
+                return Err(format!("distance must be positive, got {d}"));
             }
             o.distance = Some(d);
         }
