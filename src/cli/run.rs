@@ -178,13 +178,9 @@ pub(super) fn settle(
     bar.finish();
     match solver.equilibrium() {
         Some(r) if !r.converged => eprintln!(
-            "{}: warning: the initial equilibrium stage did not converge: R_max = {} after {} \
-             steps (tolerance {}); a block may be unstable under gravity, or raise \
-             equilibrium_max_steps",
+            "{}: warning: {}",
             scene.display(),
-            short(r.residual),
-            r.steps,
-            short(r.tolerance)
+            unconverged_stage(&r, solver.params.equilibrium_max_steps)
         ),
         Some(r) if !quiet => eprintln!(
             "initial equilibrium: R_max = {} after {} static steps",
@@ -547,9 +543,64 @@ fn settled_note(settled: u64, steps: u64) -> String {
     }
 }
 
+/// The warning for an equilibrium stage that ended unconverged, saying what ended it: its step
+/// limit, where more steps may settle the model, or before the limit the solver's test for a
+/// mechanism (R_max growing for 20 steps in a row, a block sliding away, or no longer falling
+/// for 200: `solver::equilibrium`), where more steps would not help.
+fn unconverged_stage(r: &EquilibriumReport, max_steps: u32) -> String {
+    let head = format!(
+        "the initial equilibrium stage did not converge: R_max = {} after {} of its {max_steps} \
+         steps (tolerance {})",
+        short(r.residual),
+        r.steps,
+        short(r.tolerance)
+    );
+    if r.steps < u64::from(max_steps) {
+        format!(
+            "{head}; it stopped early because R_max kept growing or stopped falling: a block \
+             moves under gravity (it slides or topples), and more steps would not bring it to \
+             rest"
+        )
+    } else {
+        format!("{head}; a block may be unstable under gravity, or raise equilibrium_max_steps")
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use super::settled_note;
+    use super::{settled_note, unconverged_stage};
+    use crate::snapshot::EquilibriumReport;
+
+    /// A stage that ended before its step limit does not advise raising the limit: it says
+    /// the mechanism test ended it (the jointed slope's stopped at 49 of 60 steps, its block
+    /// sliding, and was told to raise equilibrium_max_steps).
+    #[test]
+    fn an_unconverged_stage_says_what_ended_it() {
+        let report = |steps| EquilibriumReport {
+            steps,
+            residual: 3.689,
+            tolerance: 1e-3,
+            converged: false,
+            running: false,
+        };
+        let early = unconverged_stage(&report(49), 60);
+        assert!(
+            early.starts_with(
+                "the initial equilibrium stage did not converge: R_max = 3.689 \
+                 after 49 of its 60 steps (tolerance 0.001); it stopped early because"
+            ),
+            "{early}"
+        );
+        assert!(!early.contains("raise"), "{early}");
+        let limit = unconverged_stage(&report(60), 60);
+        assert!(
+            limit.ends_with(
+                "; a block may be unstable under gravity, or raise \
+                 equilibrium_max_steps"
+            ),
+            "{limit}"
+        );
+    }
 
     #[test]
     fn the_final_line_names_settled_steps_only_when_there_are_some() {
