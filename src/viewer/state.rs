@@ -508,6 +508,7 @@ pub(super) mod tests {
             steps_per_second: 0.0,
             seconds_per_step: 0.0,
             running_seconds: 0.0,
+            steps_run: 0,
             totals: solver.totals.clone(),
             max_step_penetration: solver.max_step_penetration(),
         };

@@ -135,7 +135,7 @@ impl FrameClock {
             * 1e3;
         let m = mean(&iv);
         let (steps, t, run_s) = frame.map_or((0, 0.0, 0.0), |f| {
-            (f.totals.steps, f.snapshot.time, f.running_seconds)
+            (f.steps_run, f.snapshot.time, f.running_seconds)
         });
         let avg_sps = if run_s > 0.0 {
             steps as f64 / run_s
@@ -167,7 +167,7 @@ impl FrameClock {
 /// The exit report's line for run B of a comparison: its solver's speed (the frame times and
 /// A's solver are on the line before).
 pub(super) fn report_b(b: &Frame) {
-    let (steps, run_s) = (b.totals.steps, b.running_seconds);
+    let (steps, run_s) = (b.steps_run, b.running_seconds);
     eprintln!(
         "viewer: compare run B ({}): solver {} steps to t = {:.3} s in {:.2} s running: {:.0} \
          steps/s (last 0.5 s: {:.0} steps/s)",

@@ -352,10 +352,13 @@ mod tests {
         let first = h.latest().expect("a frame at start");
         assert_eq!((first.snapshot.time, first.snapshot.step), (at.time, 20));
         assert_eq!(first.snapshot.blocks[1].vertices, at.blocks[1].vertices);
+        // The checkpoint's steps are not this window's (the exit report's speed counts these).
+        assert_eq!(first.steps_run, 0);
 
         let id = h.send(Command::Step);
         let f = h.wait_for(WAIT, |f| f.applied >= id && f.snapshot.step == 21);
         let f = f.expect("one step");
+        assert_eq!(f.steps_run, 1);
         assert_eq!(f.snapshot.time.to_bits(), next.time.to_bits());
         for (a, b) in f.snapshot.blocks.iter().zip(&next.blocks) {
             assert_eq!(a.vertices, b.vertices, "{}", a.name);
@@ -364,6 +367,7 @@ mod tests {
         let id = h.send(Command::Reset);
         let f = h.wait_for(WAIT, |f| f.applied >= id).unwrap();
         assert_eq!((f.snapshot.time, f.snapshot.step), (at.time, 20));
+        assert_eq!(f.steps_run, 0);
         // Bytes that are no checkpoint start nothing.
         let junk: Origin = vec![0u8; 64].into();
         let s = rockfall();

@@ -87,8 +87,12 @@ pub struct Frame {
     /// Mean wall time of one step, s (over the same window).
     pub seconds_per_step: f64,
     /// Wall-clock time spent running (playing or stepping) since the start, s: with
-    /// `totals.steps` it gives the solver's average speed.
+    /// `steps_run` it gives the solver's average speed.
     pub running_seconds: f64,
+    /// Steps this window ran since the run started, was reset or loaded (the steps in
+    /// `totals` include those of the checkpoint it started from): with `running_seconds`, the
+    /// solver's average speed.
+    pub steps_run: u64,
     pub totals: RunTotals,
     /// d_n,max = 2 δ w0 of (P22), m: the penetration scale ε1 is measured against.
     pub max_step_penetration: f64,

@@ -113,6 +113,9 @@ struct Sim {
     running_before: Duration,
     /// Start of the current Running stretch.
     running_since: Option<Instant>,
+    /// The solver's step count when this run started, was reset or loaded: a checkpoint's
+    /// steps are not this window's.
+    steps_before: u64,
 }
 
 impl Sim {
@@ -126,7 +129,6 @@ impl Sim {
         let now = Instant::now();
         Sim {
             scene_duration: start.params.duration,
-            solver,
             start,
             state: RunState::Paused,
             speed,
@@ -151,6 +153,8 @@ impl Sim {
             seconds_per_step: 0.0,
             running_before: Duration::ZERO,
             running_since: None,
+            steps_before: solver.totals.steps,
+            solver,
         }
     }
 
@@ -238,6 +242,7 @@ impl Sim {
     fn start_over(&mut self, solver: Solver) {
         self.running_before = Duration::ZERO;
         self.running_since = None;
+        self.steps_before = solver.totals.steps;
         self.solver = solver;
         self.generation += 1;
         self.records.clear();
@@ -449,6 +454,7 @@ impl Sim {
             running_seconds: (self.running_before
                 + self.running_since.map_or(Duration::ZERO, |t| t.elapsed()))
             .as_secs_f64(),
+            steps_run: self.solver.totals.steps.saturating_sub(self.steps_before),
             totals: self.solver.totals.clone(),
             max_step_penetration: self.solver.max_step_penetration(),
         };
