@@ -336,14 +336,44 @@ fn absurd_overrides_are_rejected_naming_the_flag() {
         err.contains("1e8 steps, more than the limit of 1e7"),
         "{err}"
     );
-    // At the ends of the ranges a run goes: ten steps of the shortest Δt_max, one of the longest.
-    for args in [
-        ["--max-time-step", "1e-7", "--duration", "1e-6"],
-        ["--max-time-step", "1", "--duration", "1e-7"],
+    // The shortest Δt_max is too short for this 2750 kg block: its inertia would dwarf every
+    // penalty the ALM may reach, and the message says which Δt_max would do.
+    let short_run = bin()
+        .arg("run")
+        .arg(&path)
+        .args([
+            "--max-time-step",
+            "1e-7",
+            "--duration",
+            "1e-6",
+            "--quiet",
+            "--out",
+        ])
+        .arg(dir.join("o"))
+        .output()
+        .unwrap();
+    let err = one_line_error(&short_run, "1e-7");
+    assert!(
+        err.starts_with("error: --max-time-step: ") && err.contains("max_time_step ≥ 1.18"),
+        "{err}"
+    );
+    assert!(err.len() < 240, "{err}");
+    // At the ends of the ranges a run goes: ten steps of the shortest Δt_max (for a 4 cm
+    // block), one of the longest.
+    let pebble = dir.join("pebble.toml");
+    let small = "size = [0.04, 0.04, 0.04], center = [0, 0, 0.02]";
+    std::fs::write(
+        &pebble,
+        scene("").replace("size = [1, 1, 1], center = [0, 0, 0.5]", small),
+    )
+    .unwrap();
+    for (scene_path, args) in [
+        (&pebble, ["--max-time-step", "1e-7", "--duration", "1e-6"]),
+        (&path, ["--max-time-step", "1", "--duration", "1e-7"]),
     ] {
         let out = bin()
             .arg("run")
-            .arg(&path)
+            .arg(scene_path)
             .args(args)
             .args(["--quiet", "--out"])
             .arg(dir.join("o"))

@@ -34,6 +34,7 @@ mod write;
 use std::fmt;
 use std::path::Path;
 
+pub use build::{MAX_INERTIA_PER_PENALTY_CAP, check_inertia_scale};
 use build::{build_block, check_material, check_overlaps, check_penalty_scale};
 use format::SceneFile;
 use locate::{LineIndex, key_at, key_line, line_of};
@@ -308,6 +309,10 @@ fn parse_cut(
         }
     }
     check_overlaps(&blocks).map_err(|(k, m)| err(lines[k], m))?;
+    check_inertia_scale(&blocks, &params).map_err(|m| {
+        let keys = [table::MAX_TIME_STEP.key, table::GAMMA.key];
+        err(first_key_line(text, &keys), m)
+    })?;
     let name = file.name.unwrap_or_else(|| default_name.to_string());
     let scene = Scene {
         name: name.clone(),
