@@ -56,16 +56,16 @@ solver.max_time_step: 1e-15 | 1e-9 | 1e3 | 1e300 | 0.0! | -0.01!
 solver.max_displacement_ratio: 1e-12 | 1e3 | 1e300 | 0.0!; solver.rotate_stress: true
 solver.gravity: [0.0, 0.0, 0.0] | [0.0, 0.0, -1e10] | [0.0, 0.0, 9.8] | [1e308, 1e308, 1e308]
 solver.gravity: [0.0, 0.0, nan]! | [0.0, -9.8]! | [0.0, 0.0, -9.8, 0.0]!
-solver.fixed_spring_factor: 1e-300! | 1e300! | 0.0! | 1.0 | 1e6; solver.max_displacement_overshoot: 1e300 | 0.5!
+solver.fixed_spring_factor: 1e-300! | 1e300! | 0.0! | 1.0 | 1e6; solver.max_displacement_overshoot: 2.0 | 1e300! | 0.5!
 solver.initial_equilibrium: true; solver.equilibrium_tolerance: 1e-300 | 0.0! | 1.0!
 solver.equilibrium_max_steps: 1 | 0! | 1000001! | 9223372036854775807!
 solver.contact.initial_penalty: 1e-300! | 1e300! | 1e30! | 0.0!; solver.contact.gamma: 1e-300! | 1e300!
-solver.contact.alpha: 1.0000001 | 1e300 | 1.0!; solver.contact.beta: 1e-300 | 1.0!
+solver.contact.alpha: 1.0000001 | 1e3 | 1e300! | 1.0!; solver.contact.beta: 1e-300 | 1.0!
 solver.contact.eps1: 1e-300 | 0.0!; solver.contact.eps2: 1e300; solver.contact.warm_start: false
 solver.contact.shear_penalty_ratio: 1e300! | 1e-300! | 100.0; solver.contact.close_threshold: 1e300
 solver.contact.max_alm_iterations: 1 | 1000000000 | 0! | 4294967296!
 solver.contact.max_open_close_iterations: 1 | 0!; solver.contact.open_threshold: -1.0!
-joint.friction_angle: 0.0 | 89.999999 | 90.0! | -1.0!; joint.cohesion: 1e308 | -1.0!
+joint.friction_angle: 0.0 | 89.999999 | 90.0! | -1.0!; joint.cohesion: 1e9 | 1e308! | -1.0!
 materials.rock.density: -2750.0! | 0.0! | 1e-300! | 1e300! | 1e-9! | 0.01 | 2e5
 materials.rock.young_modulus: -2e10! | 0.0! | 1e-300! | 1e300! | 1.0! | 100.0 | 1e13
 materials.rock.poisson_ratio: 0.5! | 1.0! | -1.0! | 0.4999999 | -0.9999999 | 0.0 | nan!";

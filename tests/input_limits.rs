@@ -274,6 +274,14 @@ fn absurd_time_controls_in_the_scene_are_rejected_at_their_line() {
         ("solver.contact", "open_threshold", "1e308"),
         ("joint", "friction_angle", "90.0"),
         ("solver", "equilibrium_max_steps", "1000001"),
+        // Unbounded above until these: each changed or slowed the run.
+        ("solver", "max_displacement_overshoot", "1e300"),
+        ("solver", "max_displacement_overshoot", "2.01"),
+        ("solver", "sleep_time", "1e300"),
+        ("solver.contact", "alpha", "1e300"),
+        ("solver.contact", "alpha", "1001"),
+        ("joint", "cohesion", "1e308"),
+        ("joint", "cohesion", "1.1e9"),
     ] {
         let text = format!("{}[{table}]\n\n{key} = {value}\n", scene(""));
         let err = run_error(&dir, &text, key);
