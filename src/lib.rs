@@ -19,12 +19,14 @@
 //!
 //! [`params`] holds every tunable; [`cli`] is the binary's front end, [`generate`] and [`bench`]
 //! its scene generator and benchmark, [`study`] its parameter studies (a scene run many times
-//! with keys varied: scene → solver → a table of outcomes).
+//! with keys varied: scene → solver → a table of outcomes), [`files`] the output directories
+//! they all make.
 
 pub mod bench;
 pub mod cli;
 pub mod compare;
 pub mod contact;
+pub mod files;
 pub mod generate;
 pub mod model;
 pub mod output;

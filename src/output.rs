@@ -139,29 +139,8 @@ pub(crate) fn num(x: f64) -> String {
 /// Creates `dir` (and its parents) as the output directory, with a clear message when the
 /// path is taken by a file.
 fn create_output_dir(dir: &Path) -> Result<(), OutputError> {
-    create_dir_clearly(dir)
+    crate::files::create_dir_clearly(dir)
         .map_err(|e| OutputError::io(dir, "cannot create the output directory", e))
-}
-
-/// Creates `dir` and its parents, as [`std::fs::create_dir_all`] does, for every command that
-/// writes into a directory it makes (`run`, `render`, `generate`, `cut`, `study`): where the
-/// path or one of its parents is a file, the error says so ("a file of that name exists",
-/// "x is a file, not a directory") instead of the system's "File exists (os error 17)" or
-/// "Not a directory (os error 20)", which name neither the file nor the directory. The caller
-/// puts `dir` and "cannot create the output directory" before it.
-pub fn create_dir_clearly(dir: &Path) -> Result<(), String> {
-    if dir.exists() && !dir.is_dir() {
-        return Err("a file of that name exists".into());
-    }
-    if let Some(file) = dir
-        .ancestors()
-        .skip(1)
-        .filter(|a| !a.as_os_str().is_empty())
-        .find(|a| a.exists() && !a.is_dir())
-    {
-        return Err(format!("{} is a file, not a directory", file.display()));
-    }
-    std::fs::create_dir_all(dir).map_err(|e| e.to_string())
 }
 
 impl RowWriter {

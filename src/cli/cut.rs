@@ -34,7 +34,7 @@ pub fn cut(args: &CutArgs) -> Result<(), CliError> {
         args.scene.with_file_name(format!("{stem}_cut.toml"))
     });
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        crate::output::create_dir_clearly(dir).map_err(|e| {
+        crate::files::create_dir_clearly(dir).map_err(|e| {
             CliError::Run(format!(
                 "{}: cannot create the output directory: {e}",
                 dir.display()

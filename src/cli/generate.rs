@@ -55,7 +55,7 @@ pub fn generate(args: &GenerateArgs) -> Result<(), CliError> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(format!("column_{}.toml", args.blocks)));
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
-        crate::output::create_dir_clearly(dir).map_err(|e| {
+        crate::files::create_dir_clearly(dir).map_err(|e| {
             CliError::Run(format!(
                 "{}: cannot create the output directory: {e}",
                 dir.display()

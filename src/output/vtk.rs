@@ -43,7 +43,7 @@ impl VtkWriter {
     /// Creates `run_dir/vtk`. `interval`: simulated time between outputs (`None`: every step).
     pub fn create(run_dir: &Path, interval: Option<f64>) -> Result<Self, OutputError> {
         let dir = run_dir.join("vtk");
-        super::create_dir_clearly(&dir)
+        crate::files::create_dir_clearly(&dir)
             .map_err(|e| OutputError::io(&dir, "cannot create the VTK directory", e))?;
         Ok(VtkWriter {
             dir,

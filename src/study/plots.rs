@@ -66,7 +66,7 @@ pub fn write_plots(
 ) -> Result<Vec<PathBuf>, String> {
     check_lengths(parameters, outcomes)?;
     let plots = dir.join("plots");
-    crate::output::create_dir_clearly(&plots).map_err(|e| {
+    crate::files::create_dir_clearly(&plots).map_err(|e| {
         format!(
             "{}: cannot create the output directory: {e}",
             plots.display()

@@ -28,7 +28,7 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), StudyError> {
 /// Creates `out` and `out/cases`.
 pub fn create_dirs(out: &Path) -> Result<(), StudyError> {
     let dir = cases_dir(out);
-    crate::output::create_dir_clearly(&dir).map_err(|e| {
+    crate::files::create_dir_clearly(&dir).map_err(|e| {
         StudyError::io(format!(
             "{}: cannot create the output directory: {e}",
             dir.display()

@@ -43,9 +43,9 @@ pub use frames::{render_rgba, render_to_png};
 pub use options::{CaptureOptions, Framing};
 
 /// Creates a directory the capture writes into, and its parents: a file in the way is named
-/// ([`crate::output::create_dir_clearly`]), as `run` names it.
+/// ([`crate::files::create_dir_clearly`]), as `run` names it.
 pub(crate) fn create_output_dir(dir: &Path) -> Result<(), RenderError> {
-    crate::output::create_dir_clearly(dir)
+    crate::files::create_dir_clearly(dir)
         .map_err(|e| RenderError::io(dir, format!("cannot create the output directory: {e}")))
 }
 

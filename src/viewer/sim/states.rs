@@ -11,7 +11,7 @@ use crate::solver::checkpoint::{self, EXTENSION};
 /// Writes the solver's state to `dir/checkpoint_<t>.ckpt`. Returns the message for the window.
 pub fn save(solver: &Solver, dir: &Path) -> Result<String, String> {
     let path = dir.join(checkpoint::file_name(solver.time));
-    crate::output::create_dir_clearly(dir).map_err(|e| {
+    crate::files::create_dir_clearly(dir).map_err(|e| {
         format!(
             "{}: cannot save the state: cannot create its directory: {e}",
             dir.display()
