@@ -27,14 +27,14 @@ pub const ALPHA: Param = Param {
     label: "α",
     unit: "",
     doc: "(P21) Penalty growth factor: p_n,k = α·p_n,k−1 when |d_n,k| > β·|d_n,k−1| (a contact \
-          whose penetration does not shrink fast enough). Paper: α = 10. At most 10³ (the \
-          panel's slider ends there): at 10³ two growths already take the paper's p_n,1 = \
-          0.01·E past its cap γ·E = 100·E, so a larger α only jumps to the cap sooner.",
+          whose penetration does not shrink fast enough). Paper: α = 10.",
     default: Value::Real(10.0),
     get: |p| Value::Real(p.contact.alpha),
     set: |p, text| assign(text, &mut p.contact.alpha),
     valid: Interval::new(Bound::Open(1.0), Bound::Closed(1e3)),
-    valid_why: "",
+    valid_why: "at 10³ two growths already take the paper's p_n,1 = 0.01·E past its cap γ·E = \
+                100·E, so a larger α only jumps to the cap sooner (1e300 was accepted and \
+                changed the run).",
     widget: absolute(1.01, 1000.0, true),
 };
 
@@ -231,12 +231,12 @@ pub const COHESION: Param = Param {
     label: "c",
     unit: "Pa",
     doc: "Joint cohesion. Acts only on joints closed from the start that have never opened or \
-          slid (Shi's rule): once broken a joint keeps only friction. At most 1 GPa: intact \
-          rock's own cohesion is some tens of MPa, so a joint of more is welded, not a joint.",
+          slid (Shi's rule): once broken a joint keeps only friction.",
     default: Value::Real(0.0),
     get: |p| Value::Real(p.joint.cohesion),
     set: |p, text| assign(text, &mut p.joint.cohesion),
     valid: Interval::new(Bound::Closed(0.0), Bound::Closed(1e9)),
-    valid_why: "",
+    valid_why: "intact rock's own cohesion is some tens of MPa: a joint of more is welded, not a \
+                joint (1e308 was accepted).",
     widget: absolute(0.0, 1e8, true),
 };

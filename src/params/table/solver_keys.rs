@@ -138,14 +138,13 @@ pub const MAX_DISPLACEMENT_OVERSHOOT: Param = Param {
     unit: "",
     doc: "A step is redone with a smaller Δt when its largest vertex displacement exceeds this \
           × δ·w0. 1 keeps every step within δ·w0, which is what the bound d_n,max = 2·δ·w0 of \
-          (P22) assumes. At most 2: beyond, a step may move a vertex past the contact window \
-          2·δ·w0, through a face it never touched.",
+          (P22) assumes.",
     default: Value::Real(1.0),
     get: |p| Value::Real(p.max_displacement_overshoot),
     set: |p, text| assign(text, &mut p.max_displacement_overshoot),
-    // The README's input limits would need a row for a reason in `valid_why`; it is in `doc`.
     valid: Interval::new(Bound::Closed(1.0), Bound::Closed(2.0)),
-    valid_why: "",
+    valid_why: "beyond 2 a step may move a vertex past the contact window 2·δ·w0 of (P22), \
+                through a face it never touched (1e300 was accepted).",
     widget: None,
 };
 
@@ -235,12 +234,11 @@ pub const SLEEP_TIME: Param = Param {
     unit: "s",
     doc: "How long every block of an island must have been still (see sleep_velocity) before \
           the island sleeps. Longer: only blocks settled for longer sleep, and a slowly \
-          accelerating block is told apart from one at rest down to a smaller acceleration. At \
-          most 10⁷ s, the longest run (duration): no block waits longer.",
+          accelerating block is told apart from one at rest down to a smaller acceleration.",
     default: Value::Real(0.1),
     get: |p| Value::Real(p.sleep_time),
     set: |p, text| assign(text, &mut p.sleep_time),
     valid: Interval::new(Bound::Open(0.0), Bound::Closed(1e7)),
-    valid_why: "",
+    valid_why: "the longest run (`duration`): no block waits longer (1e300 was accepted).",
     widget: absolute(0.01, 10.0, true),
 };
