@@ -82,6 +82,7 @@ pub struct RenderArgs {
     /// Antialiasing samples (1 or 4).
     #[arg(long, default_value_t = 4, allow_negative_numbers = true)]
     pub msaa: u32,
+    /// No progress bar and no final line.
     #[arg(long, short)]
     pub quiet: bool,
     /// Compare: also run the scene with the contact method METHOD (alm or penalty) as run B,

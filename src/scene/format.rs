@@ -36,14 +36,15 @@ pub(super) struct SceneFile {
     pub(super) output: OutputSpec,
 }
 
-/// `[output]`: the ParaView series (`crate::output::vtk`).
+/// `[output]`: the ParaView series (`crate::output::vtk`) and the output interval.
 #[derive(Deserialize, Default, Clone, Copy)]
 #[serde(deny_unknown_fields)]
 pub(super) struct OutputSpec {
     /// Write `DIR/vtk/` as `run --vtk` does.
     #[serde(default)]
     pub(super) vtk: bool,
-    /// Simulated time between VTK outputs, s (default: every step).
+    /// Simulated time between outputs, s: the CSV rows and the VTK series alike (default: every
+    /// step), as `run --output-interval`.
     pub(super) interval: Option<f64>,
 }
 

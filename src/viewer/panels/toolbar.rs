@@ -50,7 +50,13 @@ pub fn show(ui: &mut egui::Ui, state: &mut UiState, actions: &mut Vec<Action>) {
             ui.separator();
             capture_buttons(ui, state, actions);
             ui.separator();
-            state_buttons(ui, state, actions);
+            // Greyed out in a comparison, whose two runs would write one file per time (the
+            // simulation link refuses them there too).
+            ui.add_enabled_ui(state.compare.is_none(), |ui| {
+                state_buttons(ui, state, actions);
+            })
+            .response
+            .on_disabled_hover_text("Save and load state are not available in a comparison");
         },
     );
 }
