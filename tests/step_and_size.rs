@@ -104,7 +104,9 @@ fn a_time_step_too_short_for_the_heaviest_block_is_refused_with_one_that_works()
         &format!("[solver.contact]\ngamma = {gamma}\n[joint]"),
     );
     dda3d::scene::parse(&stiffer, "heavy.toml", "heavy").expect("γ as suggested");
-    // Static mode has no inertia to compare.
+    // Static mode has no inertia to compare, and DDA-3p no ALM to converge.
     let still = text.replace("duration = 1.0", "duration = 1.0\nmode = \"static\"");
     dda3d::scene::parse(&still, "heavy.toml", "heavy").expect("static");
+    let penalty = text.replace("duration = 1.0", "duration = 1.0\nmethod = \"penalty\"");
+    dda3d::scene::parse(&penalty, "heavy.toml", "heavy").expect("DDA-3p");
 }

@@ -8,7 +8,7 @@ use crate::contact::Shape;
 use crate::contact::detection::broad_phase;
 use crate::contact::groups::MAX_BLOCK_PAIRS;
 use crate::model::Block;
-use crate::params::{Mode, SolverParams};
+use crate::params::{Method, Mode, SolverParams};
 use crate::physics::geometry::{
     Vec3, bounding_box, box_vertices, convex_hull, dodecahedron_vertices, overlap_depth,
     prism_vertices, rotation_xyz_degrees,
@@ -116,11 +116,12 @@ pub(super) fn check_penalty_scale(params: &SolverParams, young: f64) -> Result<(
 /// times 277 % long, its loops ending at their cap without a word.
 pub const MAX_INERTIA_PER_PENALTY_CAP: f64 = 20.0;
 
-/// In dynamic mode, refuses a Δt_max so short for the heaviest free block that its inertia
-/// 2m/Δt_max² exceeds [`MAX_INERTIA_PER_PENALTY_CAP`] times its material's γE, naming the
-/// Δt_max and the γ that would do.
+/// In dynamic mode under DDA-3a, refuses a Δt_max so short for the heaviest free block that its
+/// inertia 2m/Δt_max² exceeds [`MAX_INERTIA_PER_PENALTY_CAP`] times its material's γE, naming
+/// the Δt_max and the γ that would do. DDA-3p keeps its fixed p_n,1 at any Δt: γE is no cap of
+/// its, and its soft springs' errors are its own (the README's "Short steps and heavy blocks").
 pub fn check_inertia_scale(blocks: &[Block], params: &SolverParams) -> Result<(), String> {
-    if params.mode != Mode::Dynamic {
+    if params.mode != Mode::Dynamic || params.method != Method::Alm {
         return Ok(());
     }
     let dt = params.max_time_step;

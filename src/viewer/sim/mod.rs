@@ -309,6 +309,16 @@ mod tests {
         assert_eq!(f.params.contact.alpha, good_alpha);
         let msg = f.error.as_deref().expect("an error message");
         assert!(msg.contains("alpha"), "{msg}");
+        // A Δt_max within its range but too short for the heaviest block, as the scene file
+        // and the flags refuse it.
+        let mut p = f.params.clone();
+        let good_dt = p.max_time_step;
+        p.max_time_step = 1e-6;
+        let id = h.send(Command::SetParams(Box::new(p)));
+        let f = h.wait_for(WAIT, |f| f.applied >= id).unwrap();
+        assert_eq!(f.params.max_time_step, good_dt);
+        let msg = f.error.as_deref().expect("an error message");
+        assert!(msg.contains("too short for block"), "{msg}");
     }
 
     #[test]

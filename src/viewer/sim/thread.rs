@@ -300,7 +300,11 @@ impl Sim {
                 let solver = self.start.solver(params);
                 self.start_over(solver.expect("the checkpoint decoded when the thread started"));
             }
-            Command::SetParams(p) => match p.validate() {
+            // Δt_max also against the heaviest block, as the scene file and the flags are.
+            Command::SetParams(p) => match p
+                .validate()
+                .and_then(|()| crate::scene::check_inertia_scale(&self.solver.model.blocks, &p))
+            {
                 Ok(()) => {
                     self.solver.set_params(*p);
                     // The end time may have moved past or before the current time.
