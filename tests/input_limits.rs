@@ -722,3 +722,39 @@ fn render_frames_are_bounded() {
         );
     }
 }
+
+#[test]
+fn gravity_is_bounded_in_magnitude() {
+    let dir = tmp("gravity");
+    for g in [
+        "[0, 0, -1e300]",
+        "[1e300, 1e300, 0]",
+        "[0, 0, -1.1e4]",
+        "[8e3, 0, -8e3]",
+    ] {
+        let err = run_error(&dir, &format!("[solver]\ngravity = {g}\n{}", scene("")), g);
+        assert!(
+            err.contains("line 2: solver.gravity's magnitude must lie in [0, 10000] m/s², got "),
+            "{g}: {err}"
+        );
+        assert!(!err.contains("inf"), "{g}: {err}");
+    }
+    // A centrifuge's hundred g, and none at all, run.
+    for g in ["[0, 0, -981]", "[0, 0, 0]"] {
+        let path = dir.join("ok.toml");
+        let text = format!("[solver]\ngravity = {g}\nduration = 0.02\n{}", scene(""));
+        std::fs::write(&path, text).unwrap();
+        let out = bin()
+            .arg("run")
+            .arg(&path)
+            .args(["--quiet", "--out"])
+            .arg(dir.join("o"))
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{g}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}

@@ -289,7 +289,27 @@ impl Param {
         let (v, mut shown) = match (self.get)(params) {
             Value::Real(v) => (v, short(v)),
             Value::Count(n) => (f64::from(n), n.to_string()),
-            Value::Vector(_) | Value::Flag(_) | Value::Choice(_) => return Ok(()),
+            // A vector's range is that of its magnitude.
+            Value::Vector(x) => {
+                // Scaled, so that 1e300 does not square to infinity.
+                let big = x.iter().fold(0.0f64, |m, c| m.max(c.abs()));
+                let norm = if big > 0.0 {
+                    big * x.iter().map(|c| (c / big).powi(2)).sum::<f64>().sqrt()
+                } else {
+                    0.0
+                };
+                if self.valid.contains(norm) {
+                    return Ok(());
+                }
+                return Err(format!(
+                    "{}'s magnitude must {}, got {}{}",
+                    self.key,
+                    self.valid.requirement(&self.suffix()),
+                    short(norm),
+                    self.suffix()
+                ));
+            }
+            Value::Flag(_) | Value::Choice(_) => return Ok(()),
         };
         if self.valid.contains(v) {
             return Ok(());

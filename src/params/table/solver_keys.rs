@@ -111,8 +111,10 @@ pub const GRAVITY: Param = Param {
     default: Value::Vector([0.0, 0.0, -9.8]),
     get: |p| Value::Vector(p.gravity),
     set: |p, text| assign(text, &mut p.gravity),
-    valid: Interval::ANY,
-    valid_why: "",
+    valid: Interval::new(Bound::Closed(0.0), Bound::Closed(1e4)),
+    valid_why: "its magnitude: a geotechnical centrifuge spins models at up to a few hundred g, \
+                and 10⁴ m/s² is a thousand; at 1e300 the first solve was not finite and the \
+                input was reported as a divergence (exit 1).",
     widget: None,
 };
 
