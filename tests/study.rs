@@ -16,12 +16,8 @@ fn scene(name: &str) -> String {
         .to_string()
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("dda3d-study-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
-}
+mod cli_support;
+use cli_support::tmp;
 
 /// A study file in `dir` over the sliding block (its own duration shortened by the study when
 /// `body` says so).

@@ -25,8 +25,37 @@ pub fn tmp(name: &str) -> PathBuf {
         .unwrap_or("test");
     let d = std::env::temp_dir().join(format!("dda3d-{test}-{}-{name}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
+    remove_stale(test, name);
     std::fs::create_dir_all(&d).unwrap();
     d
+}
+
+/// Removes the scratch directories of `test`'s `name` left by earlier runs whose process has
+/// ended (a day of test runs left some 1800 in /tmp), so that at most one per live run stays.
+/// Where `/proc` is missing (not Linux), nothing is removed.
+fn remove_stale(test: &str, name: &str) {
+    if !Path::new("/proc/self").exists() {
+        return;
+    }
+    let Ok(entries) = std::fs::read_dir(std::env::temp_dir()) else {
+        return;
+    };
+    let prefix = format!("dda3d-{test}-");
+    let suffix = format!("-{name}");
+    for e in entries.flatten() {
+        let file = e.file_name();
+        let Some(pid) = file
+            .to_str()
+            .and_then(|f| f.strip_prefix(&prefix))
+            .and_then(|f| f.strip_suffix(&suffix))
+            .and_then(|p| p.parse::<u32>().ok())
+        else {
+            continue;
+        };
+        if !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_dir_all(e.path());
+        }
+    }
 }
 
 /// The rockfall run to 0.6 s with a checkpoint at its first step past 0.5 s, in `dir/run`:
