@@ -136,8 +136,8 @@ impl ContactParams {
     /// and the block slides freely meanwhile: a 20 × 20 × 10 m block released on 20° at a factor
     /// of safety of 0.8 (2m/Δt² = 2·10¹¹ N/m at 10 ms, α·p_n,1 = 2·10⁹) went 15 % too far in
     /// 1 s and, at a factor of safety of 1.5, rattled at centimetres a second for as long as it
-    /// ran; with the cap at its inertia, 0.2 % too far, and the stable one settles within 0.1 s
-    /// of its start. A cap no higher than the inertia still stops the welding: K holds that
+    /// ran; with the cap at its inertia, 0.2 % too far, and the stable one's start-up jolt dies
+    /// out, below 0.1 mm/s by 0.15 s. A cap no higher than the inertia still stops the welding: K holds that
     /// stiffness already.
     pub fn shear_penalty(&self, p_n: f64, inertia: f64) -> f64 {
         self.shear_penalty_ratio * p_n.min((self.alpha * self.initial_penalty).max(inertia))
