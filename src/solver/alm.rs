@@ -271,13 +271,12 @@ fn update_multipliers(
         && c.dn.abs() > cp.beta * prev.abs()
         && c.dn.abs() > cp.penalty_floor * cp.eps1 * c.dn_max(p)
     {
-        let capped = (c.rec.penalty * cp.alpha).min(cp.gamma * c.young);
-        if capped > c.rec.penalty {
-            c.set_penalty(capped, cp);
-            // The spring's reference moved with p_τ, and T_b with it.
-            c.du = c.relative_displacement(d, blocks);
-            raised = true;
-        }
+        raised = raise_penalty(
+            c,
+            (c.rec.penalty * cp.alpha).min(cp.gamma * c.young),
+            p,
+            (blocks, d),
+        );
     }
     // A loop that ends at its cap with this contact's λ still moving by more than ε2 of itself,
     // where its penalty is below its lighter block's inertia 2m/Δt_max²: each (P1) update moves
@@ -297,15 +296,27 @@ fn update_multipliers(
         && c.rec.penalty < c.inertia
         && creeping(c, cp)
     {
-        let target = c.inertia.min(cp.gamma * c.young);
-        if target > c.rec.penalty {
-            c.set_penalty(target, cp);
-            c.du = c.relative_displacement(d, blocks);
-            raised = true;
-        }
+        raised |= raise_penalty(c, c.inertia.min(cp.gamma * c.young), p, (blocks, d));
     }
     c.dn_prev = Some(c.dn);
     raised
+}
+
+/// Raises a contact's penalty to `target` if that is higher; returns whether it did.
+fn raise_penalty(
+    c: &mut Active,
+    target: f64,
+    p: &SolverParams,
+    (blocks, d): (&[Block], &[f64]),
+) -> bool {
+    if target > c.rec.penalty {
+        c.set_penalty(target, &p.contact);
+        // The spring's reference moved with p_τ, and T_b with it.
+        c.du = c.relative_displacement(d, blocks);
+        true
+    } else {
+        false
+    }
 }
 
 /// d_n shrinking steadily and too slowly for the loop's cap: the same sign as in the previous
