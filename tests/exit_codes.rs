@@ -87,94 +87,34 @@ fn every_command_names_a_file_in_the_way_of_its_output_directory() {
         ),
     )
     .unwrap();
-    let cases: [(Vec<String>, String); 8] = [
+    // The two messages: the path itself is a file, or a file lies above it.
+    let exists =
+        |d: &str| format!("{d}: cannot create the output directory: a file of that name exists");
+    let under = |d: &str| {
+        format!("{d}: cannot create the output directory: {f} is a file, not a directory")
+    };
+    let (slope, study) = (scene().display().to_string(), study.display().to_string());
+    let cut = root
+        .join("scenes/jointed_slope_small.toml")
+        .display()
+        .to_string();
+    let [x, dx, frames, ab] = ["x.toml", "d/x.toml", "frames", "a/b"].map(|p| format!("{f}/{p}"));
+    let render = ["render", &slope, "-q", "--duration", "0.05", "--out"];
+    let cases: [(Vec<&str>, String); 8] = [
+        (vec!["run", &slope, "-q", "--out", &f], exists(&f)),
+        (vec!["generate", "column", "--out", &x], exists(&f)),
         (
-            vec![
-                "run".into(),
-                scene().display().to_string(),
-                "-q".into(),
-                "--out".into(),
-                f.clone(),
-            ],
-            format!("{f}: cannot create the output directory: a file of that name exists"),
+            vec!["generate", "column", "--out", &dx],
+            under(&format!("{f}/d")),
         ),
+        (vec!["cut", &cut, "--out", &x], exists(&f)),
         (
-            vec![
-                "generate".into(),
-                "column".into(),
-                "--out".into(),
-                format!("{f}/x.toml"),
-            ],
-            format!("{f}: cannot create the output directory: a file of that name exists"),
+            vec!["study", &study, "-q", "--out", &f],
+            under(&format!("{f}/cases")),
         ),
-        (
-            vec![
-                "generate".into(),
-                "column".into(),
-                "--out".into(),
-                format!("{f}/d/x.toml"),
-            ],
-            format!("{f}/d: cannot create the output directory: {f} is a file, not a directory"),
-        ),
-        (
-            vec![
-                "cut".into(),
-                root.join("scenes/jointed_slope_small.toml")
-                    .display()
-                    .to_string(),
-                "--out".into(),
-                format!("{f}/x.toml"),
-            ],
-            format!("{f}: cannot create the output directory: a file of that name exists"),
-        ),
-        (
-            vec![
-                "study".into(),
-                study.display().to_string(),
-                "-q".into(),
-                "--out".into(),
-                f.clone(),
-            ],
-            format!(
-                "{f}/cases: cannot create the output directory: {f} is a file, not a directory"
-            ),
-        ),
-        (
-            vec![
-                "render".into(),
-                scene().display().to_string(),
-                "-q".into(),
-                "--duration".into(),
-                "0.05".into(),
-                "--out".into(),
-                f.clone(),
-            ],
-            format!("{f}: cannot create the output directory: a file of that name exists"),
-        ),
-        (
-            vec![
-                "render".into(),
-                scene().display().to_string(),
-                "-q".into(),
-                "--duration".into(),
-                "0.05".into(),
-                "--out".into(),
-                format!("{f}/frames"),
-            ],
-            format!(
-                "{f}/frames: cannot create the output directory: {f} is a file, not a directory"
-            ),
-        ),
-        (
-            vec![
-                "run".into(),
-                scene().display().to_string(),
-                "-q".into(),
-                "--out".into(),
-                format!("{f}/a/b"),
-            ],
-            format!("{f}/a/b: cannot create the output directory: {f} is a file, not a directory"),
-        ),
+        ([&render[..], &[&f]].concat(), exists(&f)),
+        ([&render[..], &[&frames]].concat(), under(&frames)),
+        (vec!["run", &slope, "-q", "--out", &ab], under(&ab)),
     ];
     for (args, expected) in cases {
         let out = Command::new(env!("CARGO_BIN_EXE_dda3d"))
