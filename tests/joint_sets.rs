@@ -4,6 +4,7 @@
 //! tetrahedral wedge cut by two sets slides along their line of intersection with
 //! a = g sin ψ (1 − F) when F < 1 and stands when F ≥ 1 (rock-mass reference §3).
 
+use dda3d::params::Method;
 use dda3d::physics::geometry::{Mat3, box_vertices, convex_hull};
 use dda3d::rockmass::cut::{CutOptions, Plane, Polyhedron, cut};
 use dda3d::rockmass::orientation::{Vec3, pole};
@@ -25,8 +26,14 @@ struct Motion {
 
 /// `text` loaded, every block but the one `free` picks held, run for `duration` s (at least
 /// 0.3): how the free block moved.
-fn run_free_block(text: &str, duration: f64, free: impl Fn(&Vec3) -> bool) -> Motion {
+fn run_free_block(
+    text: &str,
+    duration: f64,
+    method: Method,
+    free: impl Fn(&Vec3) -> bool,
+) -> Motion {
     let mut s = scene::parse(text, "joints.toml", "joints").unwrap_or_else(|e| panic!("{e}"));
+    s.params.method = method;
     let mut free_blocks = 0;
     let mut k = usize::MAX;
     for (i, b) in s.model.blocks.iter_mut().enumerate() {
@@ -99,7 +106,7 @@ fn a_block_on_a_joint_takes_its_sets_friction() {
         let above = |c: &Vec3| n.dot(c) > 0.0 && c.x > 0.0;
         let t = 0.5;
         // [joint] would hold the block: only the set's friction lets it slide.
-        let m = run_free_block(&planar(dip, phi, 60.0), t, above);
+        let m = run_free_block(&planar(dip, phi, 60.0), t, Method::Alm, above);
         let (dr, pr) = (dip.to_radians(), phi.to_radians());
         let want = dda3d::rockmass::orientation::dip_vector(dip, 90.0)
             * (G * (dr.sin() - dr.cos() * pr.tan()));
@@ -121,7 +128,7 @@ fn a_block_on_a_joint_takes_its_sets_friction() {
             (t - (2.0 * along / want.norm()).sqrt()) / 0.01
         );
         // [joint] would let it slide: the set's friction holds it.
-        let m = run_free_block(&planar(dip, dip + 5.0, 1.0), t, above);
+        let m = run_free_block(&planar(dip, dip + 5.0, 1.0), t, Method::Alm, above);
         assert!(
             m.displacement.norm() < 1e-4,
             "dip {dip}: crept {} m",
@@ -206,10 +213,44 @@ fn wedge_scene(
 /// How far a sliding wedge's travel at 0.5 s may fall short of ½ a t²: its friction is lined
 /// up with its slide from the first steps (`ONSET_TURN` in `src/solver/open_close.rs`; before
 /// it, up to 8.6 %, a start a step late).
-const TRAVEL_BOUND: f64 = 0.03;
-
 #[test]
 fn the_hoek_bray_wedge_slides_along_its_line_or_stands() {
+    hoek_bray_family(
+        Method::Alm,
+        Bounds {
+            travel: 0.03,
+            acceleration: 0.01,
+            creep: 1e-4,
+        },
+    );
+}
+
+/// The same family under DDA-3p, the baseline: the acceleration within 6 % (0.02–1.3 %, and
+/// 5.9 % at F = 0.905), but a first step that gains too much speed, so that the travel at 0.5 s
+/// is 0.1–37 % too long (the nearer F is to 1, the longer); a standing wedge settles into its
+/// soft springs by up to 0.8 mm.
+#[test]
+fn the_hoek_bray_wedge_slides_under_the_baseline_too() {
+    hoek_bray_family(
+        Method::Penalty,
+        Bounds {
+            travel: 0.4,
+            acceleration: 0.06,
+            creep: 1e-3,
+        },
+    );
+}
+
+/// How far a method's wedges may be off the closed form: `travel` and `acceleration` as
+/// fractions (travel at 0.5 s against ½ a t², acceleration over the last 0.3 s), `creep` m for
+/// a wedge that stands.
+struct Bounds {
+    travel: f64,
+    acceleration: f64,
+    creep: f64,
+}
+
+fn hoek_bray_family(method: Method, bounds: Bounds) {
     let cases = [
         ((45.0, 105.0), (70.0, 235.0), (65.0, 185.0), (20.0, 20.0)),
         ((45.0, 105.0), (70.0, 235.0), (65.0, 185.0), (10.0, 10.0)),
@@ -241,7 +282,8 @@ fn the_hoek_bray_wedge_slides_along_its_line_or_stands() {
         let nt = pole(90.0, w.trend);
         let free = |c: &Vec3| na.dot(c) > 0.0 && nb.dot(c) > 0.0 && nt.dot(&(c - at)) > 0.0;
         let t = 0.5;
-        let m = run_free_block(&wedge_scene(a, b, phi, face, (w.trend, at)), t, free);
+        let text = wedge_scene(a, b, phi, face, (w.trend, at));
+        let m = run_free_block(&text, t, method, free);
         let label = format!("A {a:?} B {b:?} φ {phi:?}: F = {:.4}", w.factor_of_safety);
         if w.factor_of_safety < 1.0 {
             let d = m.displacement;
@@ -261,7 +303,7 @@ fn the_hoek_bray_wedge_slides_along_its_line_or_stands() {
                 100.0 * late
             );
             assert!(
-                late < TRAVEL_BOUND,
+                late < bounds.travel,
                 "{label}: travelled {travel} m, theory {theory} m"
             );
             println!(
@@ -277,7 +319,7 @@ fn the_hoek_bray_wedge_slides_along_its_line_or_stands() {
                 w.line
             );
             assert!(
-                error < 0.01,
+                error < bounds.acceleration,
                 "{label}: a = {:?}, closed form {:?}",
                 m.acceleration,
                 w.acceleration
@@ -288,7 +330,7 @@ fn the_hoek_bray_wedge_slides_along_its_line_or_stands() {
                 "| {a:?} | {b:?} | {face:?} | {phi:?} | {:.4} | stands | moved {:.1e} m | |",
                 w.factor_of_safety, d
             );
-            assert!(d < 1e-4, "{label}: crept {d} m");
+            assert!(d < bounds.creep, "{label}: crept {d} m");
         }
     }
 }

@@ -152,7 +152,6 @@ impl Active {
             },
             tan_phi: self.tan_phi(p),
             held: p.joints_held,
-            close_sliding: p.method == Method::Alm,
         }
     }
 

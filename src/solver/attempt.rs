@@ -137,7 +137,7 @@ fn open_close_iteration(
             dt: inp.dt,
             pass: solved.oc_passes,
             onset_turns: p.method == Method::Alm && !inp.in_stage,
-            carries: p.method == Method::Alm && !inp.in_stage && p.mode == Mode::Dynamic,
+            carries: !inp.in_stage && p.mode == Mode::Dynamic,
             holding: &Default::default(),
             pair_shear: &Default::default(),
         };
