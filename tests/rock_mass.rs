@@ -405,9 +405,11 @@ fn a_cube_of_slabs_on_two_sets_collapses_without_clamping_them() {
 
 /// A 0.5 m cube cut by three sets (seed 14 of the probe: 91 blocks, DDA-3p) holds fragments of
 /// about a cubic centimetre, 1/400 of its median block, above the default `min_volume`; one of
-/// them, squeezed by its neighbours, moves beyond δ·w0 even at the Δt floor. Where the run
+/// them, squeezed by its neighbours, moved beyond δ·w0 even at the Δt floor. Where the run
 /// stops so, its message names the block and, as a fragment of the cut, the `min_volume` that
-/// drops it; and with `min_volume` set above it the mass collapses for its 0.2 s.
+/// drops it; where it stops on the energy watchdog (as it has since DDA-3p's contacts close
+/// sliding: 90 J at 0.008 s), the message names the block with the most kinetic energy; and
+/// with `min_volume` set above the fragments the mass collapses for its 0.2 s.
 #[test]
 fn a_fragment_that_diverges_is_named_and_min_volume_drops_it() {
     let text = |min_volume: &str| {
@@ -430,11 +432,17 @@ fn a_fragment_that_diverges_is_named_and_min_volume_drops_it() {
     while !solver.finished() && stopped.is_none() {
         stopped = solver.step().err().map(|e| e.to_string());
     }
-    if let Some(e) = stopped {
-        let named = number_after(&e, "min_volume drops when set above ")
-            .unwrap_or_else(|| panic!("the divergence names no fragment: {e}"));
-        assert!(e.contains("by block \"m/"), "{e}");
-        assert!(named < 2e-6, "{named} m³: {e}");
+    match stopped {
+        Some(e) if e.contains("the energy grew") => {
+            assert!(e.contains("the most kinetic energy is block \"m/"), "{e}");
+        }
+        Some(e) => {
+            let named = number_after(&e, "min_volume drops when set above ")
+                .unwrap_or_else(|| panic!("the divergence names no fragment: {e}"));
+            assert!(e.contains("by block \"m/"), "{e}");
+            assert!(named < 2e-6, "{named} m³: {e}");
+        }
+        None => {}
     }
     runs_without_diverging(
         "seed 14, min_volume 2e-6",

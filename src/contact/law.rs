@@ -39,6 +39,10 @@ pub struct LawParams {
     /// Joints held against sliding (the equilibrium stage's first phase): a locked contact
     /// stays locked whatever its shear; it can still open.
     pub held: bool,
+    /// A contact that closes while its blocks move past each other closes sliding; otherwise
+    /// locked, as in Shi's DDA. Always under DDA-3a; under DDA-3p where one of its free blocks
+    /// already slides on another contact (`crate::solver::open_close`).
+    pub close_sliding: bool,
 }
 
 /// The share of the lighter free block's weight from which a contact counts as carrying load
@@ -176,14 +180,14 @@ pub fn classify(o: &Observation, p: &LawParams) -> Transition {
 
 /// The sliding direction of a contact that closes with the tangential motion `slip` (its slip in
 /// the solve, or the motion its blocks' velocities give over the step for a contact seen for
-/// the first time): `None` (it closes locked) below the slip tolerance, or while joints are
-/// held. Both methods: DDA-3p closed such contacts locked, as Shi's DDA does, and a Hoek–Bray
-/// wedge whose corners reached a neighbour's face each step was held by their fresh springs
-/// (7 mm of 0.18 m in 0.5 s), and a block launched along a flat base stopped after 27 % of its
-/// Coulomb distance (see `crate::solver::open_close`, where DDA-3p's friction then takes the
-/// contact's force).
+/// the first time): `None` (it closes locked) below the slip tolerance, while joints are held,
+/// or without [`LawParams::close_sliding`]. DDA-3p closed every contact locked, as Shi's DDA
+/// does: a Hoek–Bray wedge whose corners reached a neighbour's face each step was held by their
+/// fresh springs (7 mm of 0.18 m in 0.5 s), and a block launched along a flat base stopped after
+/// 27 % of its Coulomb distance (see `crate::solver::open_close`, where DDA-3p's friction then
+/// takes the contact's force).
 pub fn closes_sliding(slip: &Vec3, p: &LawParams) -> Option<Vec3> {
-    (slip.norm() > p.slip_tolerance && !p.held).then(|| slip.normalize())
+    (p.close_sliding && slip.norm() > p.slip_tolerance && !p.held).then(|| slip.normalize())
 }
 
 /// The new sliding direction of a sliding contact that slipped by `o.slip` (not reversed):
@@ -303,6 +307,7 @@ mod tests {
             loaded_force: f64::INFINITY,
             tan_phi: 35f64.to_radians().tan(),
             held: false,
+            close_sliding: true,
         }
     }
 
@@ -598,7 +603,8 @@ mod tests {
 
     /// An open contact that closes while its blocks move past each other closes sliding along
     /// that motion, whatever the motion's direction; one that closes at rest closes locked; and
-    /// held joints (the equilibrium stage) close locked.
+    /// held joints (the equilibrium stage) and Shi's rule (DDA-3p where no block slides) close
+    /// locked.
     #[test]
     fn a_contact_closing_in_motion_closes_sliding() {
         let p = law();
@@ -619,6 +625,15 @@ mod tests {
             );
             let held = LawParams { held: true, ..p };
             assert_eq!(classify(&o, &held), Transition::Close, "held, slip {slip}");
+            let shi = LawParams {
+                close_sliding: false,
+                ..p
+            };
+            assert_eq!(
+                classify(&o, &shi),
+                Transition::Close,
+                "Shi's rule, slip {slip}"
+            );
         }
         o.slip = Vec3::new(0.5e-6, 0.0, 0.0);
         assert_eq!(classify(&o, &p), Transition::Close, "below the tolerance");

@@ -301,7 +301,8 @@ fn keep_overlap(
 /// in the open–close check does. Started locked, a vertex reaching the face of a block it slid
 /// along held its block for a pass while every other contact of the block read as stopped: a
 /// Hoek–Bray wedge sliding on ten contacts stuck each time one of its corners passed a
-/// neighbour's corner, and bounced back.
+/// neighbour's corner, and bounced back. Both methods (DDA-3p's closing in the open–close
+/// check asks more, see `open_close::sliding_blocks`).
 fn slide_if_moving(active: &mut [Active], new: &[bool], inp: &ActivationInputs) {
     for (c, &new) in active.iter_mut().zip(new) {
         if !new || c.rec.state != ContactState::Lock {

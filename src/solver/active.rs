@@ -152,6 +152,7 @@ impl Active {
             },
             tan_phi: self.tan_phi(p),
             held: p.joints_held,
+            close_sliding: true,
         }
     }
 

@@ -139,6 +139,7 @@ fn open_close_iteration(
             onset_turns: p.method == Method::Alm && !inp.in_stage,
             carries: !inp.in_stage && p.mode == Mode::Dynamic,
             holding: &Default::default(),
+            sliding_blocks: &Default::default(),
             pair_shear: &Default::default(),
         };
         let changed = open_close::check(&check, &solved.d, active, counters);

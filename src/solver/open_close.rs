@@ -12,7 +12,7 @@ use super::active::Active;
 use super::counters::{Counters, debug_log};
 use super::step_control::Retry;
 use crate::contact::ContactState;
-use crate::contact::law::{self, Observation, Transition};
+use crate::contact::law::{self, LawParams, Observation, Transition};
 use crate::model::Block;
 use crate::params::step_rules::SETTLE_FRACTION;
 use crate::params::{Method, SolverParams};
@@ -87,6 +87,9 @@ pub(crate) struct CheckInputs<'a> {
     /// Block pairs whose intact cohesive joint holds as a whole ([`holding_joints`]); filled
     /// by [`check`] itself.
     pub holding: &'a BTreeSet<(usize, usize)>,
+    /// DDA-3p: the free blocks with a sliding contact ([`sliding_blocks`]); filled by [`check`]
+    /// itself.
+    pub sliding_blocks: &'a BTreeSet<usize>,
     /// The resultant shear force of each block pair's locked springs, on the lower-numbered
     /// block ([`pair_shears`]); filled by [`check`] itself.
     pub pair_shear: &'a BTreeMap<(usize, usize), Vec3>,
@@ -113,6 +116,41 @@ fn holding_joints(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeSet<(
         .filter(|(_, (shear, strength))| shear.norm() <= *strength)
         .map(|(pair, _)| pair)
         .collect()
+}
+
+/// DDA-3p: the free blocks that slide on one of their contacts. A contact of such a block that
+/// closes while its blocks move past each other closes sliding (`law::closes_sliding`): the
+/// block slides, and the corner it brings onto a face slides with it. Elsewhere it closes
+/// locked, as in Shi's DDA: a block rocking on its soft springs (5 m on 30°, φ 60°, without the
+/// equilibrium stage) landed on sliding corners, walked down the slope and crept 66 mm in 9 s
+/// (0.3 mm locked).
+pub(crate) fn sliding_blocks(
+    params: &SolverParams,
+    blocks: &[Block],
+    active: &[Active],
+) -> BTreeSet<usize> {
+    if params.method != Method::Penalty {
+        return BTreeSet::new();
+    }
+    active
+        .iter()
+        .filter(|c| c.rec.state == ContactState::Slide)
+        .flat_map(|c| {
+            let (i, j) = c.blocks();
+            [i, j]
+        })
+        .filter(|&k| !blocks[k].fixed)
+        .collect()
+}
+
+/// The contact law's thresholds for `c`, with DDA-3p's closing rule ([`sliding_blocks`]).
+pub(crate) fn law_of(params: &SolverParams, c: &Active, sliding: &BTreeSet<usize>) -> LawParams {
+    let mut law = c.law(params);
+    if params.method == Method::Penalty {
+        let (i, j) = c.blocks();
+        law.close_sliding = sliding.contains(&i) || sliding.contains(&j);
+    }
+    law
 }
 
 /// A contact's block pair, the lower-numbered block first.
@@ -144,6 +182,7 @@ pub(crate) fn check(
     counters: &mut Counters,
 ) -> bool {
     let holding = holding_joints(inp, d, active);
+    let sliding_blocks = sliding_blocks(inp.params, inp.blocks, active);
     let pair_shear = if inp.onset_turns {
         pair_shears(inp, d, active)
     } else {
@@ -151,6 +190,7 @@ pub(crate) fn check(
     };
     let inp = &CheckInputs {
         holding: &holding,
+        sliding_blocks: &sliding_blocks,
         pair_shear: &pair_shear,
         ..*inp
     };
@@ -327,7 +367,8 @@ fn classify(inp: &CheckInputs, c: &mut Active, du: &Vec3) -> (Transition, Vec3) 
         carried: (inp.carries && c.rec.state == ContactState::Slide)
             .then(|| c.carried(inp.blocks, inp.dt)),
     };
-    (law::classify(&seen, &c.law(inp.params)), shear)
+    let law = law_of(inp.params, c, inp.sliding_blocks);
+    (law::classify(&seen, &law), shear)
 }
 
 /// Applies the law's verdict to the contact's record.

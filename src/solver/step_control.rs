@@ -123,16 +123,23 @@ pub(crate) fn displacement_divergence(r: f64, c: &Culprit) -> String {
         c.name,
         short(c.volume)
     );
-    if let Some(median) = c.median.filter(|m| c.volume < FRAGMENT_SHARE * m) {
-        s += &format!(
+    s += &fragment_remedy(c);
+    s
+}
+
+/// For a block `c` that is a fragment of a rock mass (under [`FRAGMENT_SHARE`] of its median
+/// block), the clause that says so and gives the `min_volume` that drops it; empty otherwise.
+pub(crate) fn fragment_remedy(c: &Culprit) -> String {
+    match c.median.filter(|m| c.volume < FRAGMENT_SHARE * m) {
+        Some(median) => format!(
             "; it is 1/{} of its rock mass's median block: a fragment of the cut, which the rock \
              mass's min_volume drops when set above {} m³ (by default blocks under 10⁻³ of the \
              median are dropped)",
             short((median / c.volume).round()),
             short(c.volume)
-        );
+        ),
+        None => String::new(),
     }
-    s
 }
 
 /// d_n,max = 2 δ w0 of (P22): the largest penetration a step can make, m.
