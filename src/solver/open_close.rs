@@ -124,11 +124,7 @@ fn holding_joints(inp: &CheckInputs, d: &[f64], active: &[Active]) -> BTreeSet<(
 /// locked, as in Shi's DDA: a block rocking on its soft springs (5 m on 30°, φ 60°, without the
 /// equilibrium stage) landed on sliding corners, walked down the slope and crept 66 mm in 9 s
 /// (0.3 mm locked).
-pub(crate) fn sliding_blocks(
-    params: &SolverParams,
-    blocks: &[Block],
-    active: &[Active],
-) -> BTreeSet<usize> {
+fn sliding_blocks(params: &SolverParams, blocks: &[Block], active: &[Active]) -> BTreeSet<usize> {
     if params.method != Method::Penalty {
         return BTreeSet::new();
     }
@@ -144,7 +140,7 @@ pub(crate) fn sliding_blocks(
 }
 
 /// The contact law's thresholds for `c`, with DDA-3p's closing rule ([`sliding_blocks`]).
-pub(crate) fn law_of(params: &SolverParams, c: &Active, sliding: &BTreeSet<usize>) -> LawParams {
+fn law_of(params: &SolverParams, c: &Active, sliding: &BTreeSet<usize>) -> LawParams {
     let mut law = c.law(params);
     if params.method == Method::Penalty {
         let (i, j) = c.blocks();
