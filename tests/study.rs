@@ -477,6 +477,27 @@ fn a_case_scene_written_out_runs_to_the_recorded_outcome() {
     );
     let text = std::fs::read_to_string(&case_scene).unwrap();
     assert!(text.contains("friction_angle = 20.0"), "{text}");
+    // A file in the way of its directory is named (status 74); a missing directory is made.
+    let in_the_way = dir.join("case1.toml").join("x.toml");
+    let o = study(
+        &["--case", "1", "--write-scene", in_the_way.to_str().unwrap()],
+        &file,
+        &dir.join("unused"),
+    );
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(74), "{err}");
+    assert!(
+        err.contains("case1.toml is a file, not a directory"),
+        "{err}"
+    );
+    let nested = dir.join("new").join("case1.toml");
+    let o = study(
+        &["--case", "1", "--write-scene", nested.to_str().unwrap()],
+        &file,
+        &dir.join("unused"),
+    );
+    assert_eq!(o.status.code(), Some(0), "{o:?}");
+    assert_eq!(std::fs::read_to_string(&nested).unwrap(), text);
     let run_out = dir.join("run");
     let status = Command::new(env!("CARGO_BIN_EXE_dda3d"))
         .args(["run", case_scene.to_str().unwrap(), "--quiet", "--out"])

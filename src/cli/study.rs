@@ -62,8 +62,20 @@ pub(super) fn execute(args: &StudyArgs) -> Result<(), Failure> {
     let study = Study::load(&args.study).map_err(failure)?;
     if let (Some(k), Some(file)) = (args.case, &args.write_scene) {
         let task = study.task(k).map_err(failure)?;
+        let cannot = |e: String| Failure::Io(format!("{}: cannot write: {e}", file.display()));
+        // Its directory is made as `--out`'s is, and a file in the way is named (the system's
+        // "Not a directory" named nothing).
+        if let Some(dir) = file.parent().filter(|d| !d.as_os_str().is_empty()) {
+            if dir.exists() && !dir.is_dir() {
+                return Err(cannot(format!(
+                    "{} is a file, not a directory",
+                    dir.display()
+                )));
+            }
+            crate::files::create_dir_clearly(dir).map_err(cannot)?;
+        }
         return crate::output::write_atomically(file, task.scene_text.as_bytes())
-            .map_err(|e| Failure::Io(format!("{}: cannot write: {e}", file.display())));
+            .map_err(|e| cannot(e.to_string()));
     }
     let out = args.out.clone().unwrap_or_else(|| default_out(&args.study));
     // Also refuses another study's directory before anything is written, --case included.
