@@ -138,3 +138,44 @@ fn a_time_step_too_short_for_the_heaviest_block_is_refused_with_one_that_works()
     let penalty = text.replace("duration = 1.0", "duration = 1.0\nmethod = \"penalty\"");
     dda3d::scene::parse(&penalty, "heavy.toml", "heavy").expect("DDA-3p");
 }
+
+/// On the command line the check sees the flags: a scene whose Δt_max is too short for DDA-3a's
+/// heaviest block is refused as it stands (status 2, the file named), and runs with
+/// `--method penalty` or a `--max-time-step` that will do. (It was refused at parse, before
+/// the flags were applied, even with `--method penalty`.)
+#[test]
+fn the_command_line_checks_the_time_step_with_its_flags() {
+    let dir = std::env::temp_dir().join(format!("dda3d-heavy-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let scene = dir.join("heavy.toml");
+    std::fs::write(&scene, slope(30.0, 0.8, 20.0, 0.0005)).unwrap();
+    let run = |extra: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_dda3d"))
+            .arg("run")
+            .arg(&scene)
+            .args(["--duration", "0.002", "-q", "--out"])
+            .arg(dir.join("out"))
+            .args(extra)
+            .output()
+            .unwrap()
+    };
+    let o = run(&[]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("heavy.toml") && err.contains("max_time_step ≥"),
+        "{err}"
+    );
+    for flags in [
+        &["--method", "penalty"][..],
+        &["--max-time-step", "0.01"],
+        &["--mode", "static"],
+    ] {
+        let o = run(flags);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "{flags:?}: {err}");
+    }
+    let o = run(&["--method", "alm"]);
+    assert_eq!(o.status.code(), Some(2), "--method alm keeps the refusal");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -136,7 +136,14 @@ impl From<SceneError> for CliError {
 /// Loads a scene and applies the command-line overrides, which the parameter table checks as it
 /// checks the scene file: a failure names the flag that set the value.
 pub fn load_scene(path: &Path, o: &SolverOverrides) -> Result<Scene, CliError> {
-    let mut s = scene::load(path)?;
+    // Δt_max against the heaviest block is checked at parse, unless a flag changes what it
+    // depends on: then once the flags are applied (below).
+    let changed = o.max_time_step.is_some() || o.method.is_some() || o.mode.is_some();
+    let mut s = if changed {
+        scene::load_deferring_inertia_check(path)?
+    } else {
+        scene::load(path)?
+    };
     if let Some(m) = o.method {
         s.params.method = m;
     }
@@ -192,9 +199,7 @@ pub fn load_scene(path: &Path, o: &SolverOverrides) -> Result<Scene, CliError> {
             .map_or_else(|| path.display().to_string(), |(f, _)| f.to_string());
         CliError::Input(format!("{flag}: {}", e.message))
     })?;
-    // Δt_max against the heaviest block, where a flag changed what the scene file's own check
-    // (at parse) saw.
-    let changed = o.max_time_step.is_some() || o.method.is_some() || o.mode.is_some();
+    // Δt_max against the heaviest block, where a flag changed what it depends on.
     if changed {
         crate::scene::check_inertia_scale(&s.model.blocks, &s.params).map_err(|m| {
             let flag = if o.max_time_step.is_some() {

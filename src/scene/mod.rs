@@ -207,7 +207,16 @@ fn first_key_line(text: &str, keys: &[&str]) -> Option<usize> {
 
 /// Parses scene text; `path` is used in messages only.
 pub fn parse(text: &str, path: &str, default_name: &str) -> Result<Scene, SceneError> {
-    parse_cut(text, path, default_name, false).map(|(scene, _)| scene)
+    parse_cut(text, path, default_name, false, true).map(|(scene, _)| scene)
+}
+
+/// [`load`] without the check of Δt_max against the heaviest block
+/// ([`check_inertia_scale`]), for a caller that changes the method, the mode or Δt_max before
+/// it runs the check itself: the command line, where `--method penalty` on a scene whose
+/// Δt_max is too short for DDA-3a was refused for DDA-3a's sake.
+pub fn load_deferring_inertia_check(path: &Path) -> Result<Scene, SceneError> {
+    let (text, shown, default_name) = read_text(path)?;
+    parse_cut(&text, &shown, &default_name, false, false).map(|(scene, _)| scene)
 }
 
 /// What the rock masses were cut into, as `dda3d cut` writes it out: the corners each of their
@@ -224,6 +233,7 @@ fn parse_cut(
     path: &str,
     default_name: &str,
     keep_points: bool,
+    check_inertia: bool,
 ) -> Result<(Scene, CutOutput), SceneError> {
     let err = |line: Option<usize>, message: String| SceneError {
         path: path.to_string(),
@@ -309,10 +319,12 @@ fn parse_cut(
         }
     }
     check_overlaps(&blocks).map_err(|(k, m)| err(lines[k], m))?;
-    check_inertia_scale(&blocks, &params).map_err(|m| {
-        let keys = [table::MAX_TIME_STEP.key, table::GAMMA.key];
-        err(first_key_line(text, &keys), m)
-    })?;
+    if check_inertia {
+        check_inertia_scale(&blocks, &params).map_err(|m| {
+            let keys = [table::MAX_TIME_STEP.key, table::GAMMA.key];
+            err(first_key_line(text, &keys), m)
+        })?;
+    }
     let name = file.name.unwrap_or_else(|| default_name.to_string());
     let scene = Scene {
         name: name.clone(),

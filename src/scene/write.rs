@@ -12,7 +12,7 @@ use super::{CutOutput, RockMassReport, Scene, SceneError, parse_cut, read_text};
 /// The cut scene's text and what each rock mass was cut into.
 pub fn cut_scene(path: &Path) -> Result<(String, Vec<RockMassReport>), SceneError> {
     let (text, shown, default_name) = read_text(path)?;
-    let (scene, cut) = parse_cut(&text, &shown, &default_name, true)?;
+    let (scene, cut) = parse_cut(&text, &shown, &default_name, true, true)?;
     let mut doc: DocumentMut = text.parse().map_err(|e: toml_edit::TomlError| SceneError {
         path: shown.clone(),
         line: None,
