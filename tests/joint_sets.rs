@@ -264,6 +264,7 @@ fn hoek_bray_family(method: Method, bounds: Bounds) {
         ((45.0, 105.0), (70.0, 235.0), (65.0, 185.0), (30.0, 30.0)),
         ((50.0, 130.0), (50.0, 230.0), (70.0, 180.0), (35.0, 35.0)),
     ];
+    println!("{method:?}:");
     println!(
         "| set A (dip, dip dir.) | set B | slope face | φ_A, φ_B | F | a, closed form (m/s²) | a, dda3d | error |"
     );

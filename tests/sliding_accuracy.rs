@@ -255,10 +255,9 @@ fn launched(phi: f64, speed: f64, a: f64, h: f64, turn: f64) -> String {
 /// Blocks launched along a flat base stop after Coulomb's v² / (2 μ g), by either method. All
 /// contacts of the first step start locked: under DDA-3p their springs tipped the block onto its
 /// front edge, the friction of the pass after took that pass's tenfold normal force, and a 1 m
-/// block at 2 m/s on φ = 30° stopped after 0.095 m of 0.353 m; corners that left the base and
-/// came back closed locked again (Shi's rule) and braked it too. DDA-3p's
-/// contacts now close sliding where their blocks move past each other, and take their force as
-/// friction in the solve after (`open_close::check_one`).
+/// block at 2 m/s on φ = 30° stopped after 0.095 m of 0.353 m. DDA-3p's contacts now close
+/// sliding where their block already slides, and take their force as friction in the solve
+/// after (`open_close::check_one`).
 #[test]
 fn launched_blocks_stop_where_coulomb_says() {
     let mut worst = [(0.0f64, String::new()), (0.0f64, String::new())];
