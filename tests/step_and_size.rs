@@ -7,6 +7,7 @@
 
 use dda3d::params::Method;
 
+mod cli_support;
 mod travel_support;
 use travel_support::{on_slope, travel};
 
@@ -145,12 +146,11 @@ fn a_time_step_too_short_for_the_heaviest_block_is_refused_with_one_that_works()
 /// the flags were applied, even with `--method penalty`.)
 #[test]
 fn the_command_line_checks_the_time_step_with_its_flags() {
-    let dir = std::env::temp_dir().join(format!("dda3d-heavy-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = cli_support::tmp("heavy");
     let scene = dir.join("heavy.toml");
     std::fs::write(&scene, slope(30.0, 0.8, 20.0, 0.0005)).unwrap();
     let run = |extra: &[&str]| {
-        std::process::Command::new(env!("CARGO_BIN_EXE_dda3d"))
+        cli_support::bin()
             .arg("run")
             .arg(&scene)
             .args(["--duration", "0.002", "-q", "--out"])
@@ -177,5 +177,4 @@ fn the_command_line_checks_the_time_step_with_its_flags() {
     }
     let o = run(&["--method", "alm"]);
     assert_eq!(o.status.code(), Some(2), "--method alm keeps the refusal");
-    let _ = std::fs::remove_dir_all(&dir);
 }
