@@ -217,6 +217,7 @@ fn activate_one(
         flips: 0,
         frozen: false,
         stopped: false,
+        stop_fraction: None,
         changed: false,
         shear: Vec3::zeros(),
         slip: Vec3::zeros(),

@@ -70,6 +70,9 @@ pub(crate) struct Active {
     pub frozen: bool,
     /// Stopped by the contact law in this attempt ([`law::Observation::restarted`]).
     pub stopped: bool,
+    /// The share of Δt at which this contact's sliding stopped, where its slip reversed within
+    /// the attempt while it was sliding fast ([`super::step_control::stop_within`]).
+    pub stop_fraction: Option<f64>,
     /// Changed state in the last open–close pass.
     pub changed: bool,
     /// N(Δ + Δu_ab) of a locked contact after the last solve.

@@ -32,6 +32,8 @@ pub(crate) struct AttemptInputs<'a> {
     pub held: &'a [bool],
     /// The step belongs to the initial equilibrium stage.
     pub in_stage: bool,
+    /// The attempt may be redone at the time a sliding contact stopped ([`Retry::Stop`]).
+    pub stop_cuts: bool,
 }
 
 /// The solution of one attempt at a step.
@@ -58,7 +60,11 @@ pub(crate) fn attempt(
     let checked =
         step_control::check_solution(inp.params, inp.blocks, inp.groups, &solved.d, active);
     counters.totals.timings.bookkeeping += watch.seconds();
-    checked.map(|()| solved)
+    checked?;
+    match stopped_blocks(inp.blocks, active) {
+        Some(f) if inp.stop_cuts => Err(Retry::Stop(f)),
+        _ => Ok(solved),
+    }
 }
 
 /// The open–close passes, each an ALM loop followed by the open–close check, until no contact
@@ -82,6 +88,7 @@ fn open_close_iteration(
         c.flips = 0;
         c.frozen = false;
         c.stopped = false;
+        c.stop_fraction = None;
         c.release_overlap(inp.dt);
         c.predict_lateral(p, inp.blocks, inp.dt);
     }
@@ -138,6 +145,7 @@ fn open_close_iteration(
             pass: solved.oc_passes,
             onset_turns: p.method == Method::Alm && !inp.in_stage,
             carries: !inp.in_stage && p.mode == Mode::Dynamic,
+            stop_cuts: inp.stop_cuts,
             holding: &Default::default(),
             sliding_blocks: &Default::default(),
             pair_shear: &Default::default(),
@@ -149,6 +157,34 @@ fn open_close_iteration(
         }
     }
     Ok(solved)
+}
+
+/// The earliest share of the step at which a free block that slid on all its contacts stopped on
+/// all of them ([`step_control::stop_within`]), if one did: the step is then redone to end
+/// there. A block whose contacts did not all stop (a block of a wall, held by neighbours while
+/// one contact's slip turns back) is not: the step is global, and a struck wall of 100 blocks,
+/// cut at every such contact, took 549 steps for 0.6 s instead of 87.
+fn stopped_blocks(blocks: &[Block], active: &[Active]) -> Option<f64> {
+    let mut per_block: Vec<(u32, u32, f64)> = vec![(0, 0, f64::INFINITY); blocks.len()];
+    for c in active
+        .iter()
+        .filter(|c| c.rec.state.is_closed() || c.stop_fraction.is_some())
+    {
+        let (i, j) = c.blocks();
+        for b in [i, j].into_iter().filter(|&b| !blocks[b].fixed) {
+            let e = &mut per_block[b];
+            e.0 += 1;
+            if let Some(f) = c.stop_fraction {
+                e.1 += 1;
+                e.2 = e.2.min(f);
+            }
+        }
+    }
+    per_block
+        .into_iter()
+        .filter(|&(closed, stopped, _)| closed > 0 && stopped == closed)
+        .map(|(_, _, f)| f)
+        .reduce(f64::min)
 }
 
 /// How far beyond the step's displacement bound (`max_displacement_overshoot · δ·w0`) an
@@ -202,6 +238,7 @@ mod tests {
             at_floor: false,
             held: &[],
             in_stage: false,
+            stop_cuts: false,
         };
         // The bound: r = 1 at a lift of δ·w0 · overshoot; measure it from the check itself.
         let (_, _, d) = cube_lifted(1.0);

@@ -405,7 +405,7 @@ impl Solver {
         let (mut active, mut kmat) = self.detect(&groups, &held);
         self.totals.timings.detection += watch.seconds();
 
-        let (solved, dt, cuts, factorizations) =
+        let (solved, dt, cuts, stop_cut, factorizations) =
             self.solve(&mut kmat, &mut active, &groups, &held, first)?;
         self.linear.matrix = Some(kmat);
 
@@ -448,7 +448,9 @@ impl Solver {
 
         self.count(&stats, active.len());
         self.last = commit::with_energy(stats, &self.model.blocks, self.params.gravity);
-        self.dt = step_control::next_dt(&self.params, base, dt, cuts);
+        // A step cut to end where a block stopped ([`Retry::Stop`]) landed on an event, as one
+        // shortened to land on a time limit does: it does not hold the next step back.
+        self.dt = step_control::next_dt(&self.params, base, dt, cuts - stop_cut as u32);
         Ok((dt, solved.settled))
     }
 
@@ -505,7 +507,8 @@ impl Solver {
     }
 
     /// Stages 2–4: attempts at the step from Δt = `first`, cut after each failure, until one
-    /// is accepted. Returns the solution, the step taken, the cuts and the factorizations.
+    /// is accepted. Returns the solution, the step taken, the cuts, whether one of them ended
+    /// the step where a block stopped ([`Retry::Stop`]) and the factorizations.
     fn solve(
         &mut self,
         kmat: &mut BlockMatrix,
@@ -513,12 +516,13 @@ impl Solver {
         groups: &ContactGroups,
         held: &[bool],
         first: f64,
-    ) -> Result<(Solved, f64, u32, u32), SolverError> {
+    ) -> Result<(Solved, f64, u32, bool, u32), SolverError> {
         let floor = step_control::dt_floor(&self.params);
         let scheme = self.scheme();
         let mut counters = Counters::new(&mut self.totals);
         let mut dt = first;
         let mut cuts = 0u32;
+        let mut stop_cut = false;
         loop {
             let at_floor = dt <= floor * (1.0 + 1e-9);
             let inputs = AttemptInputs {
@@ -532,6 +536,10 @@ impl Solver {
                 at_floor,
                 held,
                 in_stage: self.stage.is_some(),
+                stop_cuts: !stop_cut
+                    && !at_floor
+                    && self.stage.is_none()
+                    && self.params.mode == Mode::Dynamic,
             };
             let result = attempt(&inputs, kmat, &mut self.linear.chol, active, &mut counters)
                 .and_then(|solved| {
@@ -552,7 +560,7 @@ impl Solver {
             match result {
                 Ok(solved) => {
                     counters.totals.unconverged_steps += solved.settled as u64;
-                    return Ok((solved, dt, cuts, counters.factorizations));
+                    return Ok((solved, dt, cuts, stop_cut, counters.factorizations));
                 }
                 Err(reason) if at_floor => {
                     return Err(SolverError::Diverged {
@@ -570,6 +578,7 @@ impl Solver {
                     }
                     dt = reason.shortened(dt, floor);
                     cuts += 1;
+                    stop_cut |= matches!(reason, Retry::Stop(_));
                     for c in active.iter_mut() {
                         c.restart(&self.params);
                     }

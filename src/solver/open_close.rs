@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use super::PAR_CONTACTS;
 use super::active::Active;
 use super::counters::{Counters, debug_log};
-use super::step_control::Retry;
+use super::step_control::{Retry, stop_within};
 use crate::contact::ContactState;
 use crate::contact::law::{self, LawParams, Observation, Transition};
 use crate::model::Block;
@@ -84,6 +84,9 @@ pub(crate) struct CheckInputs<'a> {
     /// until a 10 cm block on 30° at Δt_max = 1 ms, sliding less than the slip tolerance a
     /// step, stopped every step under DDA-3p: 9·10⁻⁶ m of Coulomb's 0.47 m in 1 s.)
     pub carries: bool,
+    /// A sliding contact whose slip reverses records when it stopped ([`stop_within`]): dynamic
+    /// steps outside the equilibrium stage, above the Δt floor, not already cut for a stop.
+    pub stop_cuts: bool,
     /// Block pairs whose intact cohesive joint holds as a whole ([`holding_joints`]); filled
     /// by [`check`] itself.
     pub holding: &'a BTreeSet<(usize, usize)>,
@@ -279,6 +282,25 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
     };
     let before = c.rec.state;
     let (tau_before, lateral_before) = (c.rec.tau, c.lateral);
+    // A contact that slid through this solve, as it did when the step began: did its friction
+    // outlast its motion? (Read from the solve it slid in; one that sticks keeps the verdict of
+    // the solve it stuck after.)
+    let sliding_on = matches!(
+        verdict,
+        Transition::Keep | Transition::Turn { .. } | Transition::Stick
+    );
+    if inp.stop_cuts && before == ContactState::Slide && c.start.state == ContactState::Slide {
+        c.stop_fraction = if sliding_on {
+            let carried = c.carried(inp.blocks, inp.dt).dot(&c.rec.tau);
+            stop_within(
+                carried,
+                c.slip.dot(&c.rec.tau),
+                c.slip_tolerance(inp.params),
+            )
+        } else {
+            None
+        };
+    }
     apply(inp, c, verdict, shear);
     if c.rec.state == before {
         // A contact that began to slide in this step and whose friction turned by more than

@@ -8,6 +8,16 @@ use dda3d::solver::Solver;
 /// Block 1's centroid travel, m, from the start to the end of `text` run by `method` (for
 /// `duration` s, or the scene's own duration).
 pub fn travel(text: &str, method: Method, duration: Option<f64>) -> f64 {
+    displacement(text, method, duration)
+        .iter()
+        .map(|d| d * d)
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// Block 1's centroid displacement, m, from the start to the end of `text` run by `method` (for
+/// `duration` s, or the scene's own duration).
+pub fn displacement(text: &str, method: Method, duration: Option<f64>) -> [f64; 3] {
     let mut s = scene::parse(text, "block.toml", "block").expect("scene parses");
     s.params.method = method;
     if let Some(d) = duration {
@@ -19,10 +29,7 @@ pub fn travel(text: &str, method: Method, duration: Option<f64>) -> f64 {
         solver.step().expect("runs");
     }
     let end = solver.snapshot().blocks[1].centroid;
-    (0..3)
-        .map(|k| (end[k] - start[k]).powi(2))
-        .sum::<f64>()
-        .sqrt()
+    [0, 1, 2].map(|k| end[k] - start[k])
 }
 
 /// The point `s` m off a slope of `theta` degrees (along its outward normal, in the x–z plane,
