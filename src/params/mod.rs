@@ -33,6 +33,13 @@ pub mod step_rules {
     /// and shortened the following steps (9 redos in its first second). A small model, where one
     /// contact is more than this fraction, keeps Shi's rule.
     pub const SETTLE_FRACTION: f64 = 0.01;
+    /// A step in which a free block stopped on all its sliding contacts is redone to end at the
+    /// stop (`solver::step_control::stop_within`) only where the contacts slid faster than this
+    /// many slip tolerances f0·w0 a step: slower ones are the micro-slips of blocks at rest.
+    pub const STOP_CUT_SPEED: f64 = 10.0;
+    /// ... and only where the stop fell within this share of the step: nearer its end the step
+    /// is nearly right, nearer its start the speed lost is small.
+    pub const STOP_CUT_RANGE: (f64, f64) = (0.1, 0.9);
 }
 
 /// How normal contacts are enforced.

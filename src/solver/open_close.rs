@@ -84,8 +84,9 @@ pub(crate) struct CheckInputs<'a> {
     /// until a 10 cm block on 30° at Δt_max = 1 ms, sliding less than the slip tolerance a
     /// step, stopped every step under DDA-3p: 9·10⁻⁶ m of Coulomb's 0.47 m in 1 s.)
     pub carries: bool,
-    /// A sliding contact whose slip reverses records when it stopped ([`stop_within`]): dynamic
-    /// steps outside the equilibrium stage, above the Δt floor, not already cut for a stop.
+    /// A contact sliding since the step began records when its motion stopped ([`stop_within`]):
+    /// dynamic steps outside the equilibrium stage, above the Δt floor, not already cut for a
+    /// stop.
     pub stop_cuts: bool,
     /// Block pairs whose intact cohesive joint holds as a whole ([`holding_joints`]); filled
     /// by [`check`] itself.

@@ -9,7 +9,8 @@ use crate::contact::DetectionParams;
 use crate::contact::groups::{ContactGroups, MAX_BLOCK_PAIRS};
 use crate::model::Block;
 use crate::params::step_rules::{
-    DISPLACEMENT_CUT_SAFETY, DT_CUT, DT_FLOOR_DIVISOR, DT_GROWTH, PREDICT_SAFETY,
+    DISPLACEMENT_CUT_SAFETY, DT_CUT, DT_FLOOR_DIVISOR, DT_GROWTH, PREDICT_SAFETY, STOP_CUT_RANGE,
+    STOP_CUT_SPEED,
 };
 use crate::params::{Mode, SolverParams};
 use crate::physics::geometry::Vec3;
@@ -74,14 +75,6 @@ impl Retry {
         .max(floor)
     }
 }
-
-/// A sliding contact's stop must be faster than this many slip tolerances a step for the step
-/// to be cut at it ([`stop_within`]): slower ones are the micro-slips of blocks at rest.
-const STOP_CUT_SPEED: f64 = 10.0;
-
-/// The cut is made only where the stop falls within this range of the step's share: near its
-/// end the step is close to right, near its start the speed lost is small.
-const STOP_CUT_RANGE: (f64, f64) = (0.1, 0.9);
 
 /// The share of Δt at which a sliding contact stopped, for a contact that slid along τ by
 /// `carried` (its relative velocity at the step's start times Δt, along τ) and whose slip over
