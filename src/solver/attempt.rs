@@ -64,9 +64,12 @@ pub(crate) fn attempt(
     // A step settled at the pass limit is not redone for a stop: its states did not converge,
     // so neither did the stops read from them (the jointed mass of 1000, every step of which is
     // settled, redid a step of 31 passes and 70 factorizations for one).
+    if !inp.stop_cuts || solved.settled {
+        return Ok(solved);
+    }
     match stopped_blocks(inp.blocks, active) {
-        Some(f) if inp.stop_cuts && !solved.settled => Err(Retry::Stop(f)),
-        _ => Ok(solved),
+        Some(f) => Err(Retry::Stop(f)),
+        None => Ok(solved),
     }
 }
 
