@@ -45,6 +45,19 @@ pub(crate) struct Solved {
     pub settled: bool,
 }
 
+/// The attempt a step accepted, with what it took to reach it.
+pub(crate) struct Accepted {
+    pub solved: Solved,
+    /// The Δt of the accepted attempt.
+    pub dt: f64,
+    /// Attempts redone with a shorter Δt before it.
+    pub cuts: u32,
+    /// One of those cuts ended the step where a block stopped ([`Retry::Stop`]).
+    pub stop_cut: bool,
+    /// Factorizations over all the step's attempts.
+    pub factorizations: u32,
+}
+
 /// Runs one attempt. `kmat` holds the step's sparsity pattern.
 pub(crate) fn attempt(
     inp: &AttemptInputs,

@@ -30,7 +30,7 @@ pub mod watchdog;
 
 use activate::{ActivationInputs, activate_awake, contact_groups};
 use active::Active;
-use attempt::{AttemptInputs, Solved, attempt};
+use attempt::{Accepted, AttemptInputs, attempt};
 use counters::{Counters, Stopwatch, debug_log};
 use sleep::Sleep;
 use step_control::Retry;
@@ -405,8 +405,8 @@ impl Solver {
         let (mut active, mut kmat) = self.detect(&groups, &held);
         self.totals.timings.detection += watch.seconds();
 
-        let (solved, dt, cuts, stop_cut, factorizations) =
-            self.solve(&mut kmat, &mut active, &groups, &held, first)?;
+        let accepted = self.solve(&mut kmat, &mut active, &groups, &held, first)?;
+        let (solved, dt, cuts) = (accepted.solved, accepted.dt, accepted.cuts);
         self.linear.matrix = Some(kmat);
 
         let watch = Stopwatch::start();
@@ -417,7 +417,7 @@ impl Solver {
             open_close_iterations: solved.oc_passes,
             alm_iterations: solved.solves,
             time_step_cuts: cuts,
-            factorizations,
+            factorizations: accepted.factorizations,
             ..commit::contact_stats(&active, &contacts)
         };
         if !held.is_empty() {
@@ -450,7 +450,7 @@ impl Solver {
         self.last = commit::with_energy(stats, &self.model.blocks, self.params.gravity);
         // A step cut to end where a block stopped ([`Retry::Stop`]) landed on an event, as one
         // shortened to land on a time limit does: it does not hold the next step back.
-        self.dt = step_control::next_dt(&self.params, base, dt, cuts - stop_cut as u32);
+        self.dt = step_control::next_dt(&self.params, base, dt, cuts - accepted.stop_cut as u32);
         Ok((dt, solved.settled))
     }
 
@@ -507,8 +507,7 @@ impl Solver {
     }
 
     /// Stages 2–4: attempts at the step from Δt = `first`, cut after each failure, until one
-    /// is accepted. Returns the solution, the step taken, the cuts, whether one of them ended
-    /// the step where a block stopped ([`Retry::Stop`]) and the factorizations.
+    /// is accepted.
     fn solve(
         &mut self,
         kmat: &mut BlockMatrix,
@@ -516,7 +515,7 @@ impl Solver {
         groups: &ContactGroups,
         held: &[bool],
         first: f64,
-    ) -> Result<(Solved, f64, u32, bool, u32), SolverError> {
+    ) -> Result<Accepted, SolverError> {
         let floor = step_control::dt_floor(&self.params);
         let scheme = self.scheme();
         let mut counters = Counters::new(&mut self.totals);
@@ -560,7 +559,13 @@ impl Solver {
             match result {
                 Ok(solved) => {
                     counters.totals.unconverged_steps += solved.settled as u64;
-                    return Ok((solved, dt, cuts, stop_cut, counters.factorizations));
+                    return Ok(Accepted {
+                        solved,
+                        dt,
+                        cuts,
+                        stop_cut,
+                        factorizations: counters.factorizations,
+                    });
                 }
                 Err(reason) if at_floor => {
                     return Err(SolverError::Diverged {
