@@ -286,21 +286,21 @@ fn check_one(inp: &CheckInputs, d: &[f64], c: &mut Active) -> (bool, u64) {
     // A contact that slid through this solve, as it did when the step began: did its friction
     // outlast its motion? (Read from the solve it slid in; one that sticks keeps the verdict of
     // the solve it stuck after.)
-    let sliding_on = matches!(
-        verdict,
-        Transition::Keep | Transition::Turn { .. } | Transition::Stick
-    );
     if inp.stop_cuts && before == ContactState::Slide && c.start.state == ContactState::Slide {
-        c.stop_fraction = if sliding_on {
-            let carried = c.carried(inp.blocks, inp.dt).dot(&c.rec.tau);
-            stop_within(
-                carried,
-                c.slip.dot(&c.rec.tau),
-                c.slip_tolerance(inp.params),
-            )
-        } else {
-            None
-        };
+        let sliding_on = matches!(
+            verdict,
+            Transition::Keep | Transition::Turn { .. } | Transition::Stick
+        );
+        c.stop_fraction = sliding_on
+            .then(|| {
+                let carried = c.carried(inp.blocks, inp.dt).dot(&c.rec.tau);
+                stop_within(
+                    carried,
+                    c.slip.dot(&c.rec.tau),
+                    c.slip_tolerance(inp.params),
+                )
+            })
+            .flatten();
     }
     apply(inp, c, verdict, shear);
     if c.rec.state == before {
