@@ -13,6 +13,13 @@ use travel_support::{displacement, on_slope, travel};
 const ROCK: &str =
     "[materials.rock]\ndensity = 2750.0\nyoung_modulus = 2.0e10\npoisson_ratio = 0.25\n";
 
+/// Keeps the largest error and its case, for the test's printed summary.
+fn keep_worst(worst: &mut (f64, String), err: f64, case: String) {
+    if err > worst.0 {
+        *worst = (err, case);
+    }
+}
+
 /// A block `a` × `a` × `h` on a fixed slope of `theta` degrees with tan φ = `fos` tan θ, long
 /// enough for the fastest block's 2 s (20 m), the block near its upper end.
 fn slope(theta: f64, fos: f64, a: f64, h: f64) -> String {
@@ -80,9 +87,7 @@ fn slides_near_the_friction_limit_match_theory_from_the_first_step() {
                     err < bound,
                     "{case}: travelled {got:.5} m, theory {want:.5} m"
                 );
-                if err > worst.0 {
-                    worst = (err, case);
-                }
+                keep_worst(&mut worst, err, case);
             }
         }
     }
@@ -108,9 +113,11 @@ fn pushed_blocks_match_theory_from_the_first_step() {
                 let want = 0.5 * (times - 1.0) * phi.to_radians().tan() * 9.8;
                 let got = travel(&push(phi, times, a, h), Method::Alm, Some(1.0));
                 let err = (got - want).abs() / want;
-                if err > worst.0 {
-                    worst = (err, format!("φ {phi}°, {times} μmg, {a} × {h} m"));
-                }
+                keep_worst(
+                    &mut worst,
+                    err,
+                    format!("φ {phi}°, {times} μmg, {a} × {h} m"),
+                );
             }
         }
     }
@@ -152,9 +159,7 @@ fn small_light_blocks_slide_as_theory_says() {
                         err < bound,
                         "{case}: travelled {got:.6} m, theory {want:.6} m"
                     );
-                    if err > worst[m].0 {
-                        worst[m] = (err, case);
-                    }
+                    keep_worst(&mut worst[m], err, case);
                 }
             }
         }
@@ -188,9 +193,7 @@ fn blocks_just_past_their_friction_limit_slide() {
                 err < 0.01,
                 "{case}: travelled {got:.6} m, theory {want:.6} m"
             );
-            if err > worst.0 {
-                worst = (err, case);
-            }
+            keep_worst(&mut worst, err, case);
         }
     }
     println!(
@@ -223,9 +226,7 @@ fn small_blocks_of_soft_rock_slide_from_their_first_step() {
                 err < 2e-3,
                 "{case}: travelled {got:.6} m, theory {want:.6} m"
             );
-            if err > worst.0 {
-                worst = (err, case);
-            }
+            keep_worst(&mut worst, err, case);
         }
     }
     println!(
@@ -280,9 +281,7 @@ fn launched_blocks_stop_where_coulomb_says() {
                         err < bound,
                         "{case}: stopped after {got:.5} m, theory {want:.5} m"
                     );
-                    if err > worst[m].0 {
-                        worst[m] = (err, case);
-                    }
+                    keep_worst(&mut worst[m], err, case);
                 }
             }
         }
@@ -361,9 +360,7 @@ fn blocks_thrown_up_a_slope_stop_and_come_back_as_coulomb_says() {
                          ({:.2} % of the {up:.4} m up)",
                         100.0 * err
                     );
-                    if err > worst[m].0 {
-                        worst[m] = (err, case);
-                    }
+                    keep_worst(&mut worst[m], err, case);
                 }
             }
         }
@@ -419,9 +416,7 @@ fn blocks_pushed_along_a_slope_hold_or_slide_as_coulomb_says() {
                         err < 1.0,
                         "{case}: moved {got:.6} m down the dip, Coulomb {want:.6} m"
                     );
-                    if err > worst[k].0 {
-                        worst[k] = (err, case);
-                    }
+                    keep_worst(&mut worst[k], err, case);
                 }
             }
         }
@@ -459,9 +454,7 @@ fn stacked_blocks_slide_together_as_coulomb_says() {
                     err < bound,
                     "{case}: the lower block slid {got:.5} m, Coulomb {want:.5} m"
                 );
-                if err > worst[k].0 {
-                    worst[k] = (err, case);
-                }
+                keep_worst(&mut worst[k], err, case);
             }
         }
     }

@@ -96,6 +96,11 @@ impl Worst {
             *self = Worst(v, case.to_owned());
         }
     }
+
+    /// Asserts that the worst is below `bound` m; `what` names it in the message.
+    fn assert_below(&self, bound: f64, what: &str) {
+        assert!(self.0 < bound, "{what} {:.3e} m at {}", self.0, self.1);
+    }
 }
 
 #[test]
@@ -150,58 +155,28 @@ fn stable_blocks_do_not_creep_in_dynamic_mode() {
         }
     }
     assert!(cases >= 100 && weak_corners >= 10, "{cases} {weak_corners}");
-    let c = &creep[0][0];
-    assert!(
-        c.0 < 1e-4,
-        "ALM without the stage: creep {:.3e} m at {}",
-        c.0,
-        c.1
-    );
+    creep[0][0].assert_below(1e-4, "ALM without the stage: creep");
     // Without the stage, from t = 0 the blocks take up their load under gravity switched on at
     // once, and the upslope corners of the tall blocks, below their own friction limit, slip
     // while the load overshoots: up to 0.13 mm (a 5 × 10 m block on 20°, its corners sliding
     // for four steps, then stuck), after which it does not creep (above). It was 4.3 mm while
     // locked contacts were soft shear springs, and 0.085 mm while a corner's friction turned
     // to the direction of a 3.5 µm sideways slip and then stuck it (see `law::turned`).
-    let d = &drift[0][0];
-    assert!(
-        d.0 < 2e-4,
-        "ALM without the stage: drift {:.3e} m at {}",
-        d.0,
-        d.1
-    );
+    drift[0][0].assert_below(2e-4, "ALM without the stage: drift");
     assert!(moved[0][0] <= 3, "{} blocks moved 0.1 mm", moved[0][0]);
     // After the stage no ALM block moves by 0.1 mm, from t = 0.
-    let d = &drift[0][1];
-    assert!(
-        d.0 < 1e-4,
-        "ALM after the stage: drift {:.3e} m at {}",
-        d.0,
-        d.1
-    );
+    drift[0][1].assert_below(1e-4, "ALM after the stage: drift");
     assert_eq!(moved[0][1], 0);
     // DDA-3p after the stage: its friction, from the last solve's p_n d_n, turned with every
     // micrometre of sideways slip, and a block on 10° at F 1.1 crept 0.13 m between 1 s and
     // 10 s; with the friction turned by the trial force (`law::turned`) the worst is 0.24 mm.
-    let c = &creep[1][1];
-    assert!(
-        c.0 < 1e-3,
-        "penalty after the stage: creep {:.3e} m at {}",
-        c.0,
-        c.1
-    );
+    creep[1][1].assert_below(1e-3, "penalty after the stage: creep");
     // DDA-3p without the stage: its blocks take up their load on soft springs and some rock;
     // the worst creeps 16 mm from 1 s to 10 s (θ 20°, F 1.5). While every contact that closed
     // moving closed sliding, a 5 m cube on 30° at F 3 landed on sliding corners as it rocked and
     // walked 66 mm; now only a block that already slides closes them so
     // (`open_close::sliding_blocks`).
-    let c = &creep[1][0];
-    assert!(
-        c.0 < 2e-2,
-        "penalty without the stage: creep {:.3e} m at {}",
-        c.0,
-        c.1
-    );
+    creep[1][0].assert_below(2e-2, "penalty without the stage: creep");
 }
 
 /// The paper's block (30°, φ = 35°, F = 1.21) in dynamic mode moves less than 0.1 mm in 10 s,
