@@ -76,6 +76,50 @@ pub struct BlockSnapshot {
     pub volume: f64,
 }
 
+/// The solver's stress `[σx, σy, σz, τyz, τzx, τxy]` (the order of the strains in T, reference
+/// (1.1)) in the snapshot's order `[σx, σy, σz, τxy, τyz, τzx]`, which is VTK's for a
+/// symmetric tensor (XX, YY, ZZ, XY, YZ, XZ), so that ParaView's tensor filters read it right.
+/// Copied as it was, the snapshot (and the `.vtu` files) gave τyz as τxy, τzx as τyz and τxy
+/// as τzx.
+pub fn stress_in_output_order(s: &[f64; 6]) -> [f64; 6] {
+    [s[0], s[1], s[2], s[5], s[3], s[4]]
+}
+
+#[cfg(test)]
+mod stress_order_tests {
+    use super::stress_in_output_order;
+    use crate::physics::mechanics::rotate_stress;
+    use nalgebra::{Matrix3, Vector6};
+
+    /// A uniaxial stress along x turned by 30° about z has τxy and no τyz, τzx; about x, τyz
+    /// alone; about y, τzx alone: each lands in its named slot.
+    #[test]
+    fn each_shear_lands_in_its_named_slot() {
+        let uniaxial = Vector6::new(1.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        let along_z = Vector6::new(0.0, 0.0, 1.0, 0.0, 0.0, 0.0);
+        let (s, c) = 30f64.to_radians().sin_cos();
+        let about_z = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        let about_x = Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c);
+        let about_y = Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c);
+        let out = |v: Vector6<f64>| stress_in_output_order(&v.into());
+        let xy = out(rotate_stress(&uniaxial, &about_z));
+        assert!(
+            (xy[3] - s * c).abs() < 1e-15 && xy[4] == 0.0 && xy[5] == 0.0,
+            "{xy:?}"
+        );
+        let yz = out(rotate_stress(&along_z, &about_x));
+        assert!(
+            (yz[4] + s * c).abs() < 1e-15 && yz[3] == 0.0 && yz[5] == 0.0,
+            "{yz:?}"
+        );
+        let zx = out(rotate_stress(&uniaxial, &about_y));
+        assert!(
+            (zx[5] + s * c).abs() < 1e-15 && zx[3] == 0.0 && zx[4] == 0.0,
+            "{zx:?}"
+        );
+    }
+}
+
 #[cfg(test)]
 impl BlockSnapshot {
     /// Test fixture: an axis-aligned cube of edge `size` with its lowest corner at `at`, at rest.

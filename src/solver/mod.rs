@@ -632,7 +632,7 @@ impl Solver {
                     velocity: [b.velocity[0], b.velocity[1], b.velocity[2]],
                     displacement: (b.mp.centroid - b.initial_centroid).into(),
                     rock_mass: b.rock_mass.map(|r| (r.mass, r.region)),
-                    stress: b.stress.into(),
+                    stress: crate::snapshot::stress_in_output_order(&b.stress.into()),
                     volume: b.mp.volume,
                 })
                 .collect(),
