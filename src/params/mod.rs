@@ -101,7 +101,8 @@ pub struct ContactParams {
     /// Penetrations below this fraction of ε1·d_n,max do not raise the penalty by (P21). The
     /// paper has no such floor; 0.01 keeps a sliding jointed mass free (raised penalties jam it
     /// at block edges), 0 lets (P21) stiffen the contacts of stacked blocks, which otherwise
-    /// self-excite (see `crate::solver`'s ALM loop, `update_multipliers`).
+    /// self-excite (see `crate::solver`'s ALM loop, `update_multipliers`). Static mode has none
+    /// (`alm::penalty_floor`).
     pub penalty_floor: f64,
     /// p_τ / p_n,1: the shear spring of locked contacts (the paper does not give p_τ; Shi's
     /// code uses p_n / 2.5).

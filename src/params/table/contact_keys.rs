@@ -111,7 +111,9 @@ pub const PENALTY_FLOOR: Param = Param {
           steps, where each ALM iteration shrinks their penetration by a few per cent: a column \
           of four 1.2 × 1.2 × 2 m blocks on a fixed one at Δt = 2 ms rocks at 4 cm/s at 0.01, \
           still at 0 (at 10 ms it is still at both). Set 0 for walls and columns without a \
-          sliding mass run at short steps. The paper has no floor.",
+          sliding mass run at short steps. Static mode has no floor, so that the contacts whose \
+          forces compatibility alone fixes converge (a column in a rigid shaft takes \
+          σh = ν/(1−ν)·σv); the equilibrium stage keeps it. The paper has no floor.",
     default: Value::Real(0.01),
     get: |p| Value::Real(p.contact.penalty_floor),
     set: |p, text| assign(text, &mut p.contact.penalty_floor),
