@@ -196,10 +196,15 @@ impl Active {
     /// not converge.
     pub fn settle(&mut self, p: &SolverParams) {
         let close_tol = p.contact.close_threshold * self.w0;
-        match law::settle(self.rec.state, self.dn, close_tol) {
+        let frictionless = self.tan_phi(p) == 0.0 && self.cohesion(p) == 0.0;
+        match law::settle(self.rec.state, self.dn, close_tol, frictionless) {
             Settled::Open => {
                 self.rec.state = ContactState::Open;
                 self.clear_normal_force();
+            }
+            Settled::Slide => {
+                self.rec.state = ContactState::Slide;
+                self.rec.intact = false;
             }
             // A sliding contact settled locked keeps its friction, as one that sticks does: a
             // fresh spring dropped it, and a block whose corner sat at its friction limit,
@@ -314,7 +319,11 @@ impl Active {
     /// shear spring's p_τ, since a contact sliding is no stiffer across its slip than it is
     /// locked. DDA-3p keeps Shi's friction, a load alone.
     pub fn set_lateral(&mut self, p: &SolverParams, slip: f64) {
-        self.lateral = if p.method == Method::Alm && self.rec.state == ContactState::Slide {
+        // A frictionless joint has nothing to be stiff with (at no slip k⊥ would be p_τ).
+        self.lateral = if p.method == Method::Alm
+            && self.rec.state == ContactState::Slide
+            && self.tan_phi(p) > 0.0
+        {
             let p_tau = p.contact.shear_penalty(self.rec.penalty, self.inertia);
             let friction = self.sliding_friction(p);
             if friction < p_tau * slip {
