@@ -8,7 +8,7 @@
 //! a contact after its second change of state in a step, settled the struck block's corners
 //! locked on the base in the impact step: 32 of the 64 collisions lost 3–124 % of their momentum
 //! to the base (the struck pair of a 0.3 m block at 1 m/s ended moving backwards). DDA-3a,
-//! which allows six changes, conserved it to 3·10⁻¹⁰ before and after.
+//! which allows six changes, conserved it to 3·10⁻⁹ before and after.
 
 use dda3d::params::Method;
 use dda3d::scene;
