@@ -196,7 +196,8 @@ impl Active {
     /// not converge.
     pub fn settle(&mut self, p: &SolverParams) {
         let close_tol = p.contact.close_threshold * self.w0;
-        let frictionless = self.tan_phi(p) == 0.0 && self.cohesion(p) == 0.0;
+        // Not in the stage's steps with the joints held, where no contact slides.
+        let frictionless = !p.joints_held && self.tan_phi(p) == 0.0 && self.cohesion(p) == 0.0;
         match law::settle(self.rec.state, self.dn, close_tol, frictionless) {
             Settled::Open => {
                 self.rec.state = ContactState::Open;
