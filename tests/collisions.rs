@@ -44,28 +44,40 @@ fn collision(length: f64, speed: f64, yaw: f64, phi: f64) -> String {
     )
 }
 
+/// The collision of [`collision`] with `method`, ready to run for 1 s.
+fn solver(length: f64, speed: f64, yaw: f64, phi: f64, method: Method) -> Solver {
+    let text = collision(length, speed, yaw, phi);
+    let mut s = scene::parse(&text, "c.toml", "c").expect("parses");
+    s.params.method = method;
+    s.params.duration = 1.0;
+    Solver::new(s.model, s.params)
+}
+
+/// The free blocks' momentum, kg·m/s.
+fn momentum(solver: &Solver) -> [f64; 3] {
+    let free = &solver.model.blocks[1..];
+    [0, 1, 2].map(|k| free.iter().map(|b| b.mass * b.velocity[k]).sum::<f64>())
+}
+
 /// The free blocks' horizontal momentum, kg·m/s, and kinetic plus gravitational energy, J
 /// (the blocks settle onto the base by their contacts' compliance: kinetic energy alone may
 /// grow by what they sink).
 fn momentum_and_energy(solver: &Solver) -> ([f64; 2], f64) {
     let free = &solver.model.blocks[1..];
-    let p = [0, 1].map(|k| free.iter().map(|b| b.mass * b.velocity[k]).sum::<f64>());
+    let [px, py, _] = momentum(solver);
     let g = -solver.params.gravity[2];
     let energy = free
         .iter()
         .map(|b| b.kinetic_energy() + b.mass * g * b.mp.centroid.z)
         .sum();
-    (p, energy)
+    ([px, py], energy)
 }
 
 /// The largest change of the horizontal momentum over the run, relative to the striker's, the
 /// largest gain of energy over the striker's kinetic energy, and the struck block's final
 /// speed.
 fn run(length: f64, speed: f64, yaw: f64, method: Method) -> (f64, f64, f64) {
-    let mut s = scene::parse(&collision(length, speed, yaw, 0.0), "c.toml", "c").expect("parses");
-    s.params.method = method;
-    s.params.duration = 1.0;
-    let mut solver = Solver::new(s.model, s.params);
+    let mut solver = solver(length, speed, yaw, 0.0, method);
     let (p0, e0) = momentum_and_energy(&solver);
     let kinetic = solver.model.blocks[1].kinetic_energy();
     let (mut change, mut energy) = (0.0f64, f64::NEG_INFINITY);
@@ -111,22 +123,12 @@ fn frictionless_collisions_conserve_momentum() {
     }
 }
 
-/// The free blocks' momentum, kg·m/s.
-fn momentum(solver: &Solver) -> [f64; 3] {
-    let free = &solver.model.blocks[1..];
-    [0, 1, 2].map(|k| free.iter().map(|b| b.mass * b.velocity[k]).sum::<f64>())
-}
-
 /// The largest ratio, over the steps of 1 s, of the base's horizontal impulse on the blocks to
 /// tan φ times its vertical one (steps in which the base pushes up with at least 1 % of the
 /// blocks' weight; the blocks push each other with equal and opposite forces, and gravity is
 /// vertical, so the change of the blocks' horizontal momentum is the base's horizontal impulse).
 fn worst_coulomb_ratio(length: f64, speed: f64, yaw: f64, phi: f64, method: Method) -> f64 {
-    let text = collision(length, speed, yaw, phi);
-    let mut s = scene::parse(&text, "c.toml", "c").expect("parses");
-    s.params.method = method;
-    s.params.duration = 1.0;
-    let mut solver = Solver::new(s.model, s.params);
+    let mut solver = solver(length, speed, yaw, phi, method);
     let mass: f64 = solver.model.blocks[1..].iter().map(|b| b.mass).sum();
     let g = -solver.params.gravity[2];
     let mut worst = 0.0f64;
