@@ -463,6 +463,7 @@ impl Solver {
             step: self.step,
             time: self.time,
             dt: self.dt,
+            in_stage: self.stage.is_some(),
         }
     }
 
