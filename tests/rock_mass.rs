@@ -477,11 +477,12 @@ fn number_after(text: &str, before: &str) -> Option<f64> {
 }
 
 /// Runs a rock mass's scene (`label` names it in messages) to its end: more than `min_blocks`
-/// blocks, every step solves, no block sinks into the base (its top at z = 0), and the blocks'
-/// kinetic energy stays below the potential energy they lost. Returns the run's largest
-/// penetration, m.
+/// blocks, every step solves, no block sinks into the base (its top at z = 0), the blocks'
+/// kinetic energy stays below the potential energy they lost, and under DDA-3a no step gains a
+/// quarter of it. Returns the run's largest penetration, m.
 fn runs_without_diverging(label: &str, text: &str, min_blocks: usize) -> f64 {
     let s = parse(text);
+    let alm = s.params.method == dda3d::params::Method::Alm;
     let mut solver = dda3d::solver::Solver::new(s.model, s.params);
     let start = solver.snapshot();
     assert!(
@@ -489,10 +490,16 @@ fn runs_without_diverging(label: &str, text: &str, min_blocks: usize) -> f64 {
         "{label}: {} blocks",
         start.blocks.len()
     );
+    // The largest rise of kinetic + gravitational + elastic energy in one step of the run.
+    let (mut before, mut largest_gain) = (None::<f64>, 0.0f64);
     while !solver.finished() {
-        if let Err(e) = solver.step() {
-            panic!("{label}: {e}");
+        let in_stage = solver.in_equilibrium_stage();
+        let stats = solver.step().unwrap_or_else(|e| panic!("{label}: {e}"));
+        let energy = stats.kinetic_energy + stats.potential_energy + stats.elastic_energy;
+        if let (Some(e0), false) = (before, in_stage) {
+            largest_gain = largest_gain.max(energy - e0);
         }
+        before = Some(energy);
     }
     let end = solver.snapshot();
     let (mut lost, mut kinetic) = (0.0, 0.0);
@@ -516,9 +523,18 @@ fn runs_without_diverging(label: &str, text: &str, min_blocks: usize) -> f64 {
         lost > 0.0 && kinetic < lost,
         "{label}: kinetic {kinetic} J, lost {lost} J"
     );
+    // No step of DDA-3a creates a quarter of what the whole collapse released: seed 10's cube
+    // of slabs once gained 1.49 J in a step (of 1.15 J released), pushing out a corner first
+    // seen 0.18 mm deep within 0.1 ms (tests/overlaps.rs). Measured: 0.15 J of 1.03 J. DDA-3p's
+    // penalty springs hold energy the balance does not count (seed 14: 0.030 J of 0.031 J).
+    assert!(
+        !alm || largest_gain < 0.25 * lost,
+        "{label}: a step gained {largest_gain} J, the collapse released {lost} J"
+    );
     let penetration = solver.totals.max_penetration;
     println!(
-        "{label}, {} blocks: kinetic {kinetic:.3} J of {lost:.3} J lost, penetration {penetration:.2e} m",
+        "{label}, {} blocks: kinetic {kinetic:.3} J of {lost:.3} J lost, penetration {penetration:.2e} m, \
+         largest gain in a step {largest_gain:.3} J",
         start.blocks.len()
     );
     penetration
