@@ -61,8 +61,8 @@ fn fastest(text: &str, overlap: f64, method: Method) -> f64 {
     let mut most = 0.0f64;
     while !solver.finished() {
         solver.step().unwrap_or_else(|e| panic!("{e}"));
-        let v = solver.snapshot().blocks[1].velocity;
-        most = most.max((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt());
+        let v = &solver.model.blocks[1].velocity;
+        most = most.max(v.fixed_rows::<3>(0).norm());
     }
     most
 }

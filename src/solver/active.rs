@@ -186,7 +186,7 @@ impl Active {
             self.rec.overlap = self.fresh_depth;
         }
         let kept = self.rec.overlap;
-        let r = (kept * (dt / OVERLAP_RELEASE_TIME).min(1.0)).min(OVERLAP_RELEASE_SPEED * dt);
+        let r = (kept * (dt / OVERLAP_RELEASE_TIME).min(1.0)).min(pushed_out_within(dt));
         self.kin.d0 += r - self.released;
         self.released = r;
         self.rec.overlap = kept - r;
