@@ -146,13 +146,14 @@ fn worst_coulomb_ratio(length: f64, speed: f64, yaw: f64, phi: f64, method: Meth
 }
 
 /// 72 collisions (φ 10° and 30°; blocks of 0.3, 1 and 2 m; 1, 3 and 6 m/s; turned 0–70°): under
-/// DDA-3a the base's friction stays within 16 % of Mohr–Coulomb in every step (measured: 15.0 %
-/// at most, a 1 m cube into a 1 m block at 6 m/s on φ 30°; 3.4 % at most on φ 10°). The excess
-/// is the impact step's: the struck block's corners have just begun to slide, with τ a degree
-/// or so off their slip and k⊥ still p_τ, so their friction pushes across τ by up to three times
-/// its strength, and the friction takes the normal force of the ALM's previous iterate, which
-/// (P24) bounds for all the contacts together, not per contact. DDA-3p's worst step is printed
-/// (57 times Mohr–Coulomb when measured, on φ 10°; 7.5 times on φ 30°).
+/// DDA-3a the base's friction stays within 5 % of Mohr–Coulomb in every step (measured: 3.4 % at
+/// most, a 2 m block struck at 6 m/s on φ 10°; 3.1 % on φ 30°). The excess left is the impact
+/// step's: the friction takes the normal force of the ALM's previous iterate, which (P24) bounds
+/// for all the contacts together, not per contact. (Before a sliding contact whose friction
+/// pushed across τ beyond its strength was solved again, `open_close::check_one`, it was 15.0 %:
+/// the struck block's corners had just begun to slide with τ a degree off their slip and k⊥
+/// still p_τ.) DDA-3p's worst step is printed (57 times Mohr–Coulomb when measured, on φ 10°;
+/// 13.2 times on φ 30°).
 #[test]
 fn friction_at_impacts_stays_near_mohr_coulomb() {
     for method in [Method::Alm, Method::Penalty] {
@@ -184,7 +185,7 @@ fn friction_at_impacts_stays_near_mohr_coulomb() {
         assert!(worst.0 > 0.5, "{method:?}: {worst:?}");
         if method == Method::Alm {
             assert!(
-                worst.0 < 1.16,
+                worst.0 < 1.05,
                 "{}: {:.4} of Mohr–Coulomb",
                 worst.1,
                 worst.0
