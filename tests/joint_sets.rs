@@ -632,7 +632,10 @@ fn a_slice_of_the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
     let g = -solver.params.gravity[2];
     let (dip, phi) = (35f64.to_radians(), 25f64.to_radians());
     let coulomb = 0.5 * g * (dip.sin() - dip.cos() * phi.tan());
-    assert!(least > 0.97 * coulomb, "a free block moved {least} m of {coulomb} m");
+    assert!(
+        least > 0.97 * coulomb,
+        "a free block moved {least} m of {coulomb} m"
+    );
     assert!(
         (median / coulomb - 1.0).abs() < 0.02,
         "half the free blocks moved {median} m or less, Coulomb {coulomb} m"

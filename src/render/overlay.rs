@@ -126,7 +126,12 @@ fn paint_caption(painter: &egui::Painter, scene: &RenderScene, top_left: Pos2) {
     );
     let stage = scene.caption.stage.map(|(steps, residual)| {
         painter.layout_no_wrap(
-            format!("equilibrium stage: step {steps}, R_max {}", short(residual)),
+            // Before its first static step the stage has no residual yet (R_max is ∞).
+            if residual.is_finite() {
+                format!("equilibrium stage: step {steps}, R_max {}", short(residual))
+            } else {
+                format!("equilibrium stage: step {steps}")
+            },
             FontId::proportional(16.0),
             STAGE_AMBER,
         )

@@ -107,7 +107,7 @@ pub const PENALTY_FLOOR: Param = Param {
           the tolerance ε1·d_n,max. 0.01 keeps the penalties of a sliding jointed mass low: \
           raised, they jam its blocks at their edges (the shipped jointed slope's free blocks \
           travel a median 0.76 m by 1 s at 0, one of them not at all, and 0.94 m at 0.01; \
-          Coulomb 0.95 m). 0 lets (P21) stiffen the contacts of stacked blocks at short time \
+          Coulomb 0.94 m). 0 lets (P21) stiffen the contacts of stacked blocks at short time \
           steps, where each ALM iteration shrinks their penetration by a few per cent: a column \
           of four 1.2 × 1.2 × 2 m blocks on a fixed one at Δt = 2 ms rocks at 4 cm/s at 0.01, \
           still at 0 (at 10 ms it is still at both). Set 0 for walls and columns without a \
