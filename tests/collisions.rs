@@ -149,11 +149,11 @@ fn worst_coulomb_ratio(length: f64, speed: f64, yaw: f64, phi: f64, method: Meth
 /// DDA-3a the base's friction stays within 5 % of Mohr–Coulomb in every step (measured: 3.4 % at
 /// most, a 2 m block struck at 6 m/s on φ 10°; 3.1 % on φ 30°). The excess left is the impact
 /// step's: the friction takes the normal force of the ALM's previous iterate, which (P24) bounds
-/// for all the contacts together, not per contact. (Before a sliding contact whose friction
-/// pushed across τ beyond its strength was solved again, `open_close::check_one`, it was 15.0 %:
-/// the struck block's corners had just begun to slide with τ a degree off their slip and k⊥
-/// still p_τ.) DDA-3p's worst step is printed (57 times Mohr–Coulomb when measured, on φ 10°;
-/// 13.2 times on φ 30°).
+/// for all the contacts together, not per contact. It was 15.0 % before a sliding contact whose
+/// friction pushed across τ beyond its strength was solved again
+/// (`open_close::pushed_beyond_friction`): the struck block's corners had just begun to slide,
+/// τ a degree off their slip and k⊥ still p_τ. DDA-3p's worst step is printed (57 times
+/// Mohr–Coulomb when measured, on φ 10°; 13.2 times on φ 30°).
 #[test]
 fn friction_at_impacts_stays_near_mohr_coulomb() {
     for method in [Method::Alm, Method::Penalty] {
