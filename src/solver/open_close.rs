@@ -77,7 +77,8 @@ pub(crate) struct CheckInputs<'a> {
     pub dt: f64,
     pub pass: u32,
     /// The friction of contacts that began to slide in the step is iterated to its direction
-    /// ([`ONSET_TURN`]): DDA-3a, outside the equilibrium stage.
+    /// ([`ONSET_TURN`]), and that of any sliding contact while it pushes across its direction
+    /// beyond its strength ([`pushed_beyond_friction`]): DDA-3a, outside the equilibrium stage.
     pub onset_turns: bool,
     /// Steps carry velocity, and a sliding contact that speeds up does not stop
     /// ([`law::speeds_up`]): dynamic steps outside the equilibrium stage. (For DDA-3a only
