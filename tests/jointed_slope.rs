@@ -1,11 +1,11 @@
 //! The whole shipped jointed slope (`scenes/jointed_slope.toml`, 250 blocks and the ground) for
 //! its first second after its equilibrium stage: the 35 blocks of the upper mass above J1's
 //! lowest daylighting plane (factor of safety 0.67) slide out as Coulomb's 1.88 m/s² has it
-//! (0.940 m from rest), and the 216 others stand. `tests/joint_sets.rs` runs a 5 m slice of it; this one
-//! caught what the slice did not: the ALM's raise of a stalled contact's penalty to its block's
-//! inertia, applied at every loop that ended at its cap, jammed five of the free slabs (0.69–0.77
-//! m in 1 s), where the slice's blocks all went 0.98 m (counted then from the scene, with what
-//! they slid in the stage).
+//! (0.940 m from rest), and the 216 others stand. `tests/joint_sets.rs` runs a 5 m slice of it;
+//! this one caught what the slice did not: the ALM's raise of a stalled contact's penalty to its
+//! block's inertia, applied at every loop that ended at its cap, jammed five of the free slabs
+//! (0.69–0.77 m in 1 s), where the slice's blocks all went 0.98 m (counted then from the scene,
+//! with what they slid in the stage).
 
 use dda3d::physics::geometry::Vec3;
 use dda3d::scene;
