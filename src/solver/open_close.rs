@@ -484,6 +484,22 @@ pub(crate) fn settle_stragglers(
     Ok(())
 }
 
+/// After the settled solve at the pass limit: opens every closed contact that solve left
+/// pulling beyond the law's opening tension ([`law::classify`]'s first test on a closed
+/// contact), and returns how many it opened.
+pub(crate) fn open_pulling(active: &mut [Active], params: &SolverParams) -> usize {
+    let mut opened = 0;
+    for c in active.iter_mut() {
+        if c.rec.state.is_closed() && c.force < -c.law(params).open_tension {
+            c.rec.state = ContactState::Open;
+            c.clear_normal_force();
+            c.rec.intact = false;
+            opened += 1;
+        }
+    }
+    opened
+}
+
 /// Closes an open contact, locked with a fresh shear spring.
 fn close(inp: &CheckInputs, c: &mut Active) {
     let cp = &inp.params.contact;
@@ -563,5 +579,39 @@ mod tests {
             0.0,
             5e-6
         ));
+    }
+
+    /// After a settled solve, only the closed contacts pulling beyond the law's opening tension
+    /// are opened (and lose their force and cohesion); open ones and lighter tensions stay.
+    #[test]
+    fn a_settled_solve_opens_only_the_contacts_pulling_beyond_the_opening_tension() {
+        let s = crate::scene::parse(crate::solver::CUBE_ON_SLAB, "cube.toml", "cube").unwrap();
+        let solver = crate::solver::Solver::new(s.model, s.params);
+        let p = solver.params.clone();
+        let mut active = solver.next_contacts();
+        assert!(active.len() >= 4, "{} contacts", active.len());
+        let limit = active[0].law(&p).open_tension;
+        assert!(limit > 0.0 && limit.is_finite());
+        // Pulling at 2 and 0.5 times the limit, and open though pulling.
+        let cases = [
+            (ContactState::Lock, -2.0, true),
+            (ContactState::Slide, -2.0, true),
+            (ContactState::Lock, -0.5, false),
+            (ContactState::Open, -2.0, false),
+        ];
+        for (c, (state, force, _)) in active.iter_mut().zip(cases) {
+            c.rec.state = state;
+            c.rec.lambda = 1.0;
+            c.rec.intact = true;
+            c.force = force * limit;
+        }
+        let opened = open_pulling(&mut active, &p);
+        assert_eq!(opened, 2);
+        for (c, (state, _, opens)) in active.iter().zip(cases) {
+            let want = if opens { ContactState::Open } else { state };
+            assert_eq!(c.rec.state, want);
+            assert_eq!(c.rec.lambda == 0.0, opens);
+            assert_eq!(c.rec.intact, !opens);
+        }
     }
 }
