@@ -491,6 +491,14 @@ pub(crate) fn open_pulling(active: &mut [Active], params: &SolverParams) -> usiz
     let mut opened = 0;
     for c in active.iter_mut() {
         if c.rec.state.is_closed() && c.force < -c.law(params).open_tension {
+            if debug_log() {
+                let (i, j) = c.blocks();
+                eprintln!(
+                    "settled solve: pair={i}-{j} pulls {:.3e} N ({:.2e} of the lighter weight), opened",
+                    -c.force,
+                    -c.force / c.weight
+                );
+            }
             c.rec.state = ContactState::Open;
             c.clear_normal_force();
             c.rec.intact = false;
