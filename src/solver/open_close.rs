@@ -466,7 +466,8 @@ fn apply(inp: &CheckInputs, c: &mut Active, verdict: Transition, shear: Vec3) {
 /// At the open–close pass limit: if more than [`SETTLE_FRACTION`] of the contacts still changed
 /// in the last pass (and the step is above the Δt floor), the attempt is redone with a shorter
 /// step (Shi). Otherwise, and always at the floor, the contacts that still changed are settled
-/// closed and locked for one more solve, and the step is accepted.
+/// closed and locked for one more solve (checked for tension, [`open_pulling`]), and the step
+/// is accepted.
 pub(crate) fn settle_stragglers(
     active: &mut [Active],
     params: &SolverParams,
