@@ -159,7 +159,9 @@ pub const MAX_OPEN_CLOSE_ITERATIONS: Param = Param {
     unit: "",
     doc: "Open–close passes before the step is redone with {DT_CUT}·Δt (Shi: 6 + 2; walls of many \
           blocks need 10–25 at an impact). If at most {SETTLE_PERCENT} % of the contacts still \
-          change then, they are settled closed and locked instead.",
+          change then, they are settled closed and locked instead; contacts the solve after \
+          leaves in tension are opened and solved again, and the step is redone shorter if it \
+          still pulls after three.",
     default: Value::Count(30),
     get: |p| Value::Count(p.contact.max_open_close_iterations),
     set: |p, text| assign(text, &mut p.contact.max_open_close_iterations),
