@@ -67,6 +67,7 @@ fn one_second(text: &str, name: &str) -> (Vec<f64>, (f64, String), f64) {
     (free, most_other, g)
 }
 
+/// The text of the shipped `scenes/jointed_slope.toml`.
 fn shipped() -> String {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/jointed_slope.toml");
     std::fs::read_to_string(path).expect("the shipped scene")
