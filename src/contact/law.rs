@@ -118,6 +118,11 @@ pub enum Transition {
     Turn { tau: Vec3 },
 }
 
+/// A closed contact under a tension beyond `open_tension` opens: [`classify`]'s first test.
+pub fn pulls_open(normal_force: f64, p: &LawParams) -> bool {
+    normal_force < -p.open_tension
+}
+
 /// Classifies one contact from the last solve.
 pub fn classify(o: &Observation, p: &LawParams) -> Transition {
     match o.state {
@@ -130,7 +135,7 @@ pub fn classify(o: &Observation, p: &LawParams) -> Transition {
                 Transition::Close
             }
         }
-        _ if o.normal_force < -p.open_tension => Transition::Open,
+        _ if pulls_open(o.normal_force, p) => Transition::Open,
         ContactState::Lock if p.held => Transition::Keep,
         ContactState::Lock => {
             let extension = o.shear.norm();

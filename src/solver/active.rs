@@ -281,6 +281,13 @@ impl Active {
         self.friction_normal = initial_friction_normal(p, &self.start);
     }
 
+    /// Opens the contact: no normal force, and no cohesion once it has opened.
+    pub fn open(&mut self) {
+        self.rec.state = ContactState::Open;
+        self.clear_normal_force();
+        self.rec.intact = false;
+    }
+
     /// Drops the contact's normal force: its multiplier λ, the force its friction takes and
     /// the multiplier it would carry into the next step (a contact that opens, closes afresh,
     /// or lets go of a tension it cannot hold).

@@ -434,11 +434,7 @@ fn apply(inp: &CheckInputs, c: &mut Active, verdict: Transition, shear: Vec3) {
             c.rec.state = ContactState::Slide;
             c.rec.tau = tau;
         }
-        Transition::Open => {
-            c.rec.state = ContactState::Open;
-            c.clear_normal_force();
-            c.rec.intact = false;
-        }
+        Transition::Open => c.open(),
         Transition::Slide { tau } => {
             c.rec.state = ContactState::Slide;
             c.rec.tau = if softens(inp, c) {
@@ -486,12 +482,12 @@ pub(crate) fn settle_stragglers(
 }
 
 /// After the settled solve at the pass limit: opens every closed contact that solve left
-/// pulling beyond the law's opening tension ([`law::classify`]'s first test on a closed
-/// contact), and returns how many it opened.
+/// pulling beyond the law's opening tension ([`law::pulls_open`]), and returns how many it
+/// opened.
 pub(crate) fn open_pulling(active: &mut [Active], params: &SolverParams) -> usize {
     let mut opened = 0;
     for c in active.iter_mut() {
-        if c.rec.state.is_closed() && c.force < -c.law(params).open_tension {
+        if c.rec.state.is_closed() && law::pulls_open(c.force, &c.law(params)) {
             if debug_log() {
                 let (i, j) = c.blocks();
                 eprintln!(
@@ -500,9 +496,7 @@ pub(crate) fn open_pulling(active: &mut [Active], params: &SolverParams) -> usiz
                     -c.force / c.weight
                 );
             }
-            c.rec.state = ContactState::Open;
-            c.clear_normal_force();
-            c.rec.intact = false;
+            c.open();
             opened += 1;
         }
     }
