@@ -12,6 +12,10 @@ use dda3d::rockmass::wedge::{Sliding, admissible, wedge};
 use dda3d::scene;
 use dda3d::solver::Solver;
 
+mod slope_support;
+
+use slope_support::{first_second, shipped};
+
 const G: f64 = 9.8;
 
 const ROCK: &str =
@@ -575,9 +579,7 @@ fn cross_cut_stacks_with_friction_above_their_dip_stand() {
 /// Few contacts are settled (the open–close iteration converges by the contact law).
 #[test]
 fn a_slice_of_the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/jointed_slope.toml");
-    let text = std::fs::read_to_string(path).expect("the shipped scene");
-    let slice = text
+    let slice = shipped()
         .replace("extrude = [0, 20, 0]", "extrude = [0, 5, 0]")
         .replace(
             "box = { size = [50, 24, 4], center = [5, 10, -2] }",
@@ -585,53 +587,15 @@ fn a_slice_of_the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
         );
     assert_eq!(slice.matches("extrude = [0, 5, 0]").count(), 2);
     assert!(slice.contains("size = [50, 9, 4]"));
-    let mut s = scene::parse(&slice, "slice.toml", "slice").unwrap_or_else(|e| panic!("{e}"));
-    s.params.duration = 1.0;
-    // J1: dip 35° toward −x through [5.7, 0, 9.5].
-    let above_j1 = |c: &Vec3| c.z > 9.5 + (c.x - 5.7) * 35f64.to_radians().tan();
-    let kinds: Vec<(String, bool)> = s
-        .model
-        .blocks
-        .iter()
-        .map(|b| {
-            let free = !b.fixed && b.name.starts_with("upper/") && above_j1(&b.mp.centroid);
-            (b.name.clone(), free)
-        })
-        .collect();
-    let mut solver = Solver::new(s.model, s.params);
-    // Travel counts from the end of the stage, where the blocks start from rest at t = 0 (the
-    // free blocks slide about 5 cm in its dynamic phase).
-    while solver.in_equilibrium_stage() {
-        solver.step().unwrap_or_else(|e| panic!("{e}"));
-    }
-    let at_rest = solver.snapshot();
-    while !solver.finished() {
-        solver.step().unwrap_or_else(|e| panic!("{e}"));
-    }
-    let snap = solver.snapshot();
-    let (mut free, mut most_other) = (Vec::new(), 0.0f64);
-    for (((name, is_free), b0), b) in kinds.iter().zip(&at_rest.blocks).zip(&snap.blocks) {
-        let moved = (Vec3::from(b.centroid) - Vec3::from(b0.centroid)).norm();
-        if *is_free {
-            free.push(moved);
-        } else {
-            most_other = most_other.max(moved);
-            assert!(moved < 0.001, "{name} moved {moved} m");
-        }
-    }
-    free.sort_by(f64::total_cmp);
+    let run = first_second(&slice, "slice.toml");
+    let (free, coulomb) = (&run.free, run.coulomb);
     let (least, median) = (free[0], free[free.len() / 2]);
-    println!(
-        "{} free blocks moved {least:.3} m or more (median {median:.3} m), the others {most_other:.4} m or less",
-        free.len()
-    );
+    let (most_other, name) = &run.most_other;
+    assert!(*most_other < 0.001, "{name} moved {most_other} m");
     assert!(free.len() >= 10, "{} free blocks", free.len());
     // Coulomb's motion on J1 (35°, φ 25°) from rest: ½ g (sin 35° − cos 35° tan 25°) t² =
     // 0.940 m in 1 s (measured: the least-moved 0.936 m, the median 0.938 m, the others 0.1 mm
     // or less; counted from the scene, before the stage, 0.983 m and 0.987 m).
-    let g = -solver.params.gravity[2];
-    let (dip, phi) = (35f64.to_radians(), 25f64.to_radians());
-    let coulomb = 0.5 * g * (dip.sin() - dip.cos() * phi.tan());
     assert!(
         least > 0.97 * coulomb,
         "a free block moved {least} m of {coulomb} m"
@@ -644,6 +608,6 @@ fn a_slice_of_the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
     // contact's state is the solver's guess. While a sliding contact at its friction limit
     // could stop, slide and stop again within a step, 1457 contacts were settled in this
     // second (2 since it stops once an attempt).
-    let settled = solver.totals.frozen_contacts;
+    let settled = run.settled;
     assert!(settled <= 50, "{settled} contacts settled");
 }

@@ -8,74 +8,14 @@
 //! with what they slid in the stage). The same slope cut closer (J3 at 4 m) checks that a step
 //! settled at the open–close pass limit does not glue the sliding mass.
 
-use dda3d::physics::geometry::Vec3;
-use dda3d::scene;
-use dda3d::solver::Solver;
+mod slope_support;
 
-/// How one second after its equilibrium stage moved the blocks of a jointed slope given as scene
-/// text: the travel of each free block (the upper mass above J1's lowest daylighting plane,
-/// dip 35° toward −x through [5.7, 0, 9.5], as the scene's comments place it), sorted, and the
-/// largest travel of any other block with its name, and g. Travel counts from t = 0, after the stage,
-/// as `scripts/jointed-slope-stats.py` measures it.
-fn one_second(text: &str, name: &str) -> (Vec<f64>, (f64, String), f64) {
-    let mut s = scene::parse(text, name, "slope").unwrap_or_else(|e| panic!("{e}"));
-    s.params.duration = 1.0;
-    let above_j1 = |c: &Vec3| c.z > 9.5 + (c.x - 5.7) * 35f64.to_radians().tan();
-    let free: Vec<(String, bool)> = s
-        .model
-        .blocks
-        .iter()
-        .map(|b| {
-            let free = !b.fixed && b.name.starts_with("upper/") && above_j1(&b.mp.centroid);
-            (b.name.clone(), free)
-        })
-        .collect();
-    let g = -s.params.gravity[2];
-    let mut solver = Solver::new(s.model, s.params);
-    while solver.in_equilibrium_stage() {
-        solver.step().unwrap_or_else(|e| panic!("{e}"));
-    }
-    let at_zero = solver.snapshot();
-    let start: Vec<(String, Vec3, bool)> = free
-        .into_iter()
-        .zip(&at_zero.blocks)
-        .map(|((name, free), b)| (name, Vec3::from(b.centroid), free))
-        .collect();
-    while !solver.finished() {
-        solver.step().unwrap_or_else(|e| panic!("{e}"));
-    }
-    let snap = solver.snapshot();
-    let (mut free, mut most_other) = (Vec::new(), (0.0f64, String::new()));
-    for ((name, c0, is_free), b) in start.iter().zip(&snap.blocks) {
-        let moved = (Vec3::from(b.centroid) - c0).norm();
-        if *is_free {
-            free.push(moved);
-        } else if moved > most_other.0 {
-            most_other = (moved, name.clone());
-        }
-    }
-    free.sort_by(f64::total_cmp);
-    println!(
-        "{name}: {} free blocks moved {:.3} m or more (median {:.3} m); the others {:.2e} m \
-         or less ({})",
-        free.len(),
-        free[0],
-        free[free.len() / 2],
-        most_other.0,
-        most_other.1
-    );
-    (free, most_other, g)
-}
-
-/// The text of the shipped `scenes/jointed_slope.toml`.
-fn shipped() -> String {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenes/jointed_slope.toml");
-    std::fs::read_to_string(path).expect("the shipped scene")
-}
+use slope_support::{first_second, shipped};
 
 #[test]
 fn the_jointed_slope_releases_its_free_blocks_and_the_rest_stands() {
-    let (free, most_other, _) = one_second(&shipped(), "jointed_slope.toml");
+    let run = first_second(&shipped(), "jointed_slope.toml");
+    let (free, most_other) = (run.free, run.most_other);
     let (least, median) = (free[0], free[free.len() / 2]);
     assert_eq!(free.len(), 35, "free blocks");
     // Measured: the least-moved 0.936 m, the median 0.94 m, the others below 0.5 mm.
@@ -112,9 +52,8 @@ fn a_settled_step_does_not_glue_the_sliding_mass_of_a_slope_cut_closer() {
         j3.replace("spacing = 5.0", "spacing = 4.0"),
         &text[at + j3.len()..]
     );
-    let (free, most_other, g) = one_second(&closer, "j3_at_4m.toml");
-    let (dip, phi) = (35f64.to_radians(), 25f64.to_radians());
-    let coulomb = 0.5 * g * (dip.sin() - dip.cos() * phi.tan());
+    let run = first_second(&closer, "j3_at_4m.toml");
+    let (free, most_other, coulomb) = (run.free, run.most_other, run.coulomb);
     let (least, median) = (free[0], free[free.len() / 2]);
     assert_eq!(free.len(), 42, "free blocks");
     assert!(
