@@ -5,69 +5,16 @@
 //! a = g sin ψ (1 − F) when F < 1 and stands when F ≥ 1 (rock-mass reference §3).
 
 use dda3d::params::Method;
-use dda3d::physics::geometry::{Mat3, box_vertices, convex_hull};
-use dda3d::rockmass::cut::{CutOptions, Plane, Polyhedron, cut};
 use dda3d::rockmass::orientation::{Vec3, pole};
-use dda3d::rockmass::wedge::{Sliding, admissible, wedge};
+use dda3d::rockmass::wedge::Sliding;
 use dda3d::scene;
 use dda3d::solver::Solver;
 
 mod slope_support;
+mod wedge_support;
 
 use slope_support::{first_second, shipped};
-
-const G: f64 = 9.8;
-
-const ROCK: &str =
-    "[materials.rock]\ndensity = 2600.0\nyoung_modulus = 1.0e10\npoisson_ratio = 0.25\n";
-
-/// What the free block did: its centroid displacement over the run, and its mean acceleration
-/// over the last 0.3 s (the velocity's change over that time).
-struct Motion {
-    displacement: Vec3,
-    acceleration: Vec3,
-}
-
-/// `text` loaded, every block but the one `free` picks held, run for `duration` s (at least
-/// 0.3): how the free block moved.
-fn run_free_block(
-    text: &str,
-    duration: f64,
-    method: Method,
-    free: impl Fn(&Vec3) -> bool,
-) -> Motion {
-    let mut s = scene::parse(text, "joints.toml", "joints").unwrap_or_else(|e| panic!("{e}"));
-    s.params.method = method;
-    let mut free_blocks = 0;
-    let mut k = usize::MAX;
-    for (i, b) in s.model.blocks.iter_mut().enumerate() {
-        if free(&b.mp.centroid) {
-            free_blocks += 1;
-            k = i;
-        } else {
-            b.fixed = true;
-            b.anchors = b.vertices.clone();
-        }
-    }
-    assert_eq!(free_blocks, 1, "one block is free");
-    s.params.duration = duration;
-    let mut solver = Solver::new(s.model, s.params);
-    let start = Vec3::from(solver.snapshot().blocks[k].centroid);
-    let mut v_before = None;
-    while !solver.finished() {
-        solver.step().expect("runs");
-        let snap = solver.snapshot();
-        if v_before.is_none() && snap.time >= duration - 0.3 - 1e-9 {
-            v_before = Some((snap.time, Vec3::from(snap.blocks[k].velocity)));
-        }
-    }
-    let snap = solver.snapshot();
-    let (t0, v0) = v_before.expect("the run reaches its last 0.3 s");
-    Motion {
-        displacement: Vec3::from(snap.blocks[k].centroid) - start,
-        acceleration: (Vec3::from(snap.blocks[k].velocity) - v0) / (snap.time - t0),
-    }
-}
+use wedge_support::{G, Run, WedgeCase, rock, run_free_block};
 
 /// One joint set J (dip `dip`, dipping east, friction `phi`) through the origin, and a vertical
 /// release joint R at x = 0, in a 3 m wide slab of rock whose top is 1 m above J and parallel to
@@ -76,9 +23,10 @@ fn run_free_block(
 /// thicker at its front than at its back: at 25° its back corners carried almost nothing, and it
 /// rocked onto them as it slid.)
 fn planar(dip: f64, phi: f64, other: f64) -> String {
+    let rock = rock(1e10);
     let (t, top) = (dip.to_radians().tan(), 1.0 / dip.to_radians().cos());
     format!(
-        "[joint]\nfriction_angle = {other}\n{ROCK}[[rock_masses]]\nname = \"m\"\n\
+        "[joint]\nfriction_angle = {other}\n{rock}[[rock_masses]]\nname = \"m\"\n\
          material = \"rock\"\nregions = [ {{ prism = {{ base = [[-3, -1.5, -3], [3, -1.5, -3], \
          [3, -1.5, {}], [-3, -1.5, {}]], extrude = [0, 3, 0] }} }} ]\n\
          [[rock_masses.joint_sets]]\nname = \"J\"\ndip = {dip}\ndip_direction = 90.0\n\
@@ -110,7 +58,7 @@ fn a_block_on_a_joint_takes_its_sets_friction() {
         let above = |c: &Vec3| n.dot(c) > 0.0 && c.x > 0.0;
         let t = 0.5;
         // [joint] would hold the block: only the set's friction lets it slide.
-        let m = run_free_block(&planar(dip, phi, 60.0), t, Method::Alm, above);
+        let m = run_free_block(&planar(dip, phi, 60.0), Run::new(t, Method::Alm), above);
         let (dr, pr) = (dip.to_radians(), phi.to_radians());
         let want = dda3d::rockmass::orientation::dip_vector(dip, 90.0)
             * (G * (dr.sin() - dr.cos() * pr.tan()));
@@ -132,81 +80,17 @@ fn a_block_on_a_joint_takes_its_sets_friction() {
             (t - (2.0 * along / want.norm()).sqrt()) / 0.01
         );
         // [joint] would let it slide: the set's friction holds it.
-        let m = run_free_block(&planar(dip, dip + 5.0, 1.0), t, Method::Alm, above);
+        let m = run_free_block(
+            &planar(dip, dip + 5.0, 1.0),
+            Run::new(t, Method::Alm),
+            above,
+        );
         assert!(
             m.displacement.norm() < 1e-4,
             "dip {dip}: crept {} m",
             m.displacement.norm()
         );
     }
-}
-
-/// A convex slope domain: the box [−4, 4] × [−3, 6] × [−3, h] behind the face plane through
-/// the origin (dip/dip direction `face`), as `vertices` for a region.
-fn slope_region(face: (f64, f64), h: f64) -> String {
-    let corners = box_vertices(
-        [8.0, 9.0, h + 3.0],
-        [0.0, 1.5, (h - 3.0) / 2.0],
-        &Mat3::identity(),
-    );
-    let (vertices, topo) = convex_hull(&corners).expect("a box");
-    let faces = topo.faces;
-    let n = pole(face.0, face.1);
-    let (pieces, _) = cut(
-        &[Polyhedron { vertices, faces }],
-        &[vec![Plane {
-            normal: n,
-            offset: 0.0,
-        }]],
-        &CutOptions {
-            min_volume: 0.0,
-            max_aspect: 1e6,
-            aspect_length: f64::INFINITY,
-            max_blocks: 10,
-        },
-    )
-    .expect("cuts");
-    let rock = pieces
-        .iter()
-        .find(|p| n.dot(&p.centroid) < 0.0)
-        .expect("rock behind the face");
-    let points: Vec<String> = rock
-        .vertices
-        .iter()
-        .map(|v| format!("[{}, {}, {}]", v.x, v.y, v.z))
-        .collect();
-    format!("{{ vertices = [{}] }}", points.join(", "))
-}
-
-/// Two sets A and B through the origin cut the slope: the wedge above both; a vertical tension
-/// crack T across the line of intersection, through `crack`, frees its front part (whose upper
-/// corners then lie inside the faces below it, see [`planar`]). T does not change F: the
-/// reactions per weight depend on A and B alone (R3.2).
-fn wedge_scene(
-    a: (f64, f64),
-    b: (f64, f64),
-    phi: (f64, f64),
-    face: (f64, f64),
-    crack: (f64, Vec3),
-) -> String {
-    let set = |name: &str, p: (f64, f64), phi: f64| {
-        format!(
-            "[[rock_masses.joint_sets]]\nname = \"{name}\"\ndip = {}\ndip_direction = {}\n\
-             spacing = 1000.0\nfriction_angle = {phi}\n",
-            p.0, p.1
-        )
-    };
-    format!(
-        "[joint]\nfriction_angle = 60.0\n{ROCK}[[rock_masses]]\nname = \"slope\"\n\
-         material = \"rock\"\nregions = [ {} ]\n{}{}{}origin = [{}, {}, {}]\n",
-        slope_region(face, 2.0),
-        set("A", a, phi.0),
-        set("B", b, phi.1),
-        set("T", (90.0, crack.0), 60.0),
-        crack.1.x,
-        crack.1.y,
-        crack.1.z
-    )
 }
 
 /// The Hoek–Bray wedge cut by two sets: when F < 1 it slides along the line of intersection of A
@@ -274,21 +158,19 @@ fn hoek_bray_family(method: Method, bounds: Bounds) {
     );
     println!("|---|---|---|---|---|---|---|---|");
     for (a, b, face, phi) in cases {
-        let w = wedge(a, b, phi.0, phi.1, G).expect("a wedge");
+        let case = WedgeCase {
+            a,
+            b,
+            face,
+            phi,
+            scale: 1.0,
+            young: 1e10,
+        };
+        let w = case.solution();
         assert!(matches!(w.sliding, Sliding::TwoPlanes), "{a:?} {b:?}");
-        assert!(
-            admissible(&w, face, (0.0, 0.0)),
-            "{a:?} {b:?} daylight in {face:?}"
-        );
-        let (na, nb) = (pole(a.0, a.1), pole(b.0, b.1));
-        // The crack: vertical, facing along the line's trend, through the line at z = 1 (half
-        // the slope's height).
-        let at = w.line * (1.0 / w.line.z);
-        let nt = pole(90.0, w.trend);
-        let free = |c: &Vec3| na.dot(c) > 0.0 && nb.dot(c) > 0.0 && nt.dot(&(c - at)) > 0.0;
         let t = 0.5;
-        let text = wedge_scene(a, b, phi, face, (w.trend, at));
-        let m = run_free_block(&text, t, method, free);
+        let (text, free) = case.scene();
+        let m = run_free_block(&text, Run::new(t, method), free);
         let label = format!("A {a:?} B {b:?} φ {phi:?}: F = {:.4}", w.factor_of_safety);
         if w.factor_of_safety < 1.0 {
             let d = m.displacement;
@@ -345,6 +227,7 @@ fn hoek_bray_family(method: Method, bounds: Bounds) {
 /// with the incline takes `[joint]`, also at `phi`); with `cross`, a second set dipping east at
 /// that angle, every 2.5 m, cuts the slabs across.
 fn stack(dip: f64, phi: f64, layers: u32, cross: Option<f64>) -> String {
+    let rock = rock(1e10);
     let (t, c) = (dip.to_radians().tan(), dip.to_radians().cos());
     let h = f64::from(layers) / c;
     let cross = cross.map_or(String::new(), |d| {
@@ -354,7 +237,7 @@ fn stack(dip: f64, phi: f64, layers: u32, cross: Option<f64>) -> String {
         )
     });
     format!(
-        "[joint]\nfriction_angle = {phi}\n{ROCK}[[blocks]]\nname = \"incline\"\n\
+        "[joint]\nfriction_angle = {phi}\n{rock}[[blocks]]\nname = \"incline\"\n\
          material = \"rock\"\nfixed = true\nprism = {{ base = [[-5, -1.5, -6], [5, -1.5, -6], \
          [5, -1.5, {}], [-5, -1.5, {}]], extrude = [0, 3, 0] }}\n\
          [[rock_masses]]\nname = \"m\"\nmaterial = \"rock\"\nregions = [ {{ prism = {{ base = \
