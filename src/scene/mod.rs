@@ -364,7 +364,19 @@ fn check_materials(
     let stiffest = file.materials.values().map(|m| m.get_ref().young_modulus);
     if let Some(young) = stiffest.reduce(f64::max) {
         check_penalty_scale(params, young).map_err(|m| {
+            let line = first_key_line(text, &[table::INITIAL_PENALTY.key]);
             let keys = [table::INITIAL_PENALTY.key, table::GAMMA.key];
+            // A penalty the file does not set is the table's default, 0.01 E of the paper's
+            // rock: say so, and what the paper's rule gives for this rock.
+            let m = if line.is_none() {
+                format!(
+                    "{m}; it is the default, the paper's 0.01 E for its E = 2e10 Pa: set it, \
+                     e.g. to 0.01 E = {} N/m",
+                    crate::text::short(0.01 * young)
+                )
+            } else {
+                m
+            };
             (first_key_line(text, &keys), m)
         })?;
     }
@@ -533,6 +545,23 @@ vertices = [[-1,-1,2],[1,-1,2],[1,1,2],[-1,1,2],[-1,-1,4],[1,-1,4],[1,1,4],[-1,1
 
     fn parse_err(text: &str) -> SceneError {
         parse(text, "s.toml", "s").expect_err("should fail")
+    }
+
+    /// A rock too soft for the default p_n,1 (2·10⁸ N/m, the paper's 0.01 E of 2·10¹⁰ Pa): the
+    /// message says the penalty is the default and what 0.01 E gives; set, it is named as set.
+    #[test]
+    fn a_default_penalty_too_stiff_for_the_rock_says_it_is_the_default() {
+        let soft = GOOD.replace("2.0e10", "1.0e6");
+        let e = parse_err(&soft);
+        assert!(e.message.contains("it is the default"), "{}", e.message);
+        assert!(e.message.contains("0.01 E = 10000 N/m"), "{}", e.message);
+        let set = soft.replace(
+            "[materials",
+            "[solver.contact]\ninitial_penalty = 3e8\n[materials",
+        );
+        let e = parse_err(&set);
+        assert!(!e.message.contains("default"), "{}", e.message);
+        assert!(e.message.contains("3e8 N/m"), "{}", e.message);
     }
 
     #[test]
