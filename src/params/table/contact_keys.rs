@@ -15,7 +15,9 @@ pub const INITIAL_PENALTY: Param = Param {
     valid: Interval::new(Bound::Closed(1.0), Bound::Closed(1e16)),
     valid_why: "outside it the penalty is no contact spring for any material dda3d takes \
           (E in [1e2, 1e13] Pa): at 1e30 or 1e300 N/m the first solve was not finite; the scene \
-          also holds it within [1e-6, γ] times its stiffest material's E.",
+          also holds it within [1e-6, γ] times its stiffest material's E (a scene that does \
+          not set it and whose rock is too soft or too stiff for the default is told so, with \
+          the paper's 0.01 E for its rock).",
     widget: Some(Widget {
         range: WidgetRange::TimesYoung(1e-6, 100.0),
         logarithmic: true,
