@@ -1,6 +1,7 @@
 //! A block on a slope slides as Coulomb says whatever the slope's dip direction and the block's
-//! yaw on it: `tests/sliding_accuracy.rs` runs slopes dipping toward +x with blocks square to
-//! the dip; here the slope turns about the vertical and the block about the slope's normal.
+//! yaw on it, and a tall one topples when its centroid overhangs its turned base:
+//! `tests/sliding_accuracy.rs` and `tests/toppling.rs` run slopes dipping toward +x with blocks
+//! square to the dip; here the slope turns about the vertical and the block about its normal.
 
 use dda3d::physics::geometry::{Mat3, Vec3, box_vertices};
 use dda3d::scene;
@@ -17,10 +18,16 @@ fn points(v: &[Vec3]) -> String {
 }
 
 /// A slope of `theta` degrees dipping toward the azimuth `psi` (degrees from +x toward +y), its
-/// face through the origin, 8a + 40 m long; on it an `a` × `a` × `a/2` block turned by `yaw`
-/// degrees about the slope's normal, near its upper end; tan φ = `fos` tan θ. Returns the
-/// scene, the unit down-dip direction and the slope's outward normal.
-fn scene_text(theta: f64, psi: f64, yaw: f64, fos: f64, a: f64) -> (String, Vec3, Vec3) {
+/// face through the origin, 8a + 40 m long; on it an `a` × `a` × `h` block turned by `yaw`
+/// degrees about the slope's normal, near its upper end; the friction angle `phi` degrees.
+/// Returns the scene, the unit down-dip direction and the slope's outward normal.
+fn scene_text(
+    theta: f64,
+    psi: f64,
+    yaw: f64,
+    phi: f64,
+    (a, h): (f64, f64),
+) -> (String, Vec3, Vec3) {
     let about = |axis: Vec3, deg: f64| {
         Rotation3::from_axis_angle(&nalgebra::Unit::new_normalize(axis), deg.to_radians())
             .into_inner()
@@ -28,7 +35,7 @@ fn scene_text(theta: f64, psi: f64, yaw: f64, fos: f64, a: f64) -> (String, Vec3
     let slope: Mat3 = about(Vec3::z(), psi) * about(Vec3::y(), theta);
     let block: Mat3 = slope * about(Vec3::z(), yaw);
     let (n, down) = (slope * Vec3::z(), slope * Vec3::x());
-    let (length, h) = (8.0 * a + 40.0, a / 2.0);
+    let length = 8.0 * a + 40.0;
     let depth = a;
     let base = box_vertices(
         [length, 4.0 * a + 4.0, depth],
@@ -37,7 +44,6 @@ fn scene_text(theta: f64, psi: f64, yaw: f64, fos: f64, a: f64) -> (String, Vec3
     );
     let on = n * h / 2.0 - down * (length / 2.0 - 2.0 * a);
     let rock = box_vertices([a, a, h], on.into(), &block);
-    let phi = (fos * theta.to_radians().tan()).atan().to_degrees();
     let text = format!(
         "[solver]\nduration = 1.0\n[joint]\nfriction_angle = {phi:?}\n\
          [materials.rock]\ndensity = 2750.0\nyoung_modulus = 1e10\npoisson_ratio = 0.25\n\
@@ -47,6 +53,17 @@ fn scene_text(theta: f64, psi: f64, yaw: f64, fos: f64, a: f64) -> (String, Vec3
         points(&rock)
     );
     (text, down, n)
+}
+
+/// How far the block moved in the 1 s of `text`, m.
+fn displacement(text: &str, label: &str) -> Vec3 {
+    let s = scene::parse(text, "o.toml", "o").unwrap_or_else(|e| panic!("{e}"));
+    let mut solver = Solver::new(s.model, s.params);
+    let start = Vec3::from(solver.snapshot().blocks[1].centroid);
+    while !solver.finished() {
+        solver.step().unwrap_or_else(|e| panic!("{label}: {e}"));
+    }
+    Vec3::from(solver.snapshot().blocks[1].centroid) - start
 }
 
 /// DDA-3a, 1 s from rest, θ 10–60°, dip directions 37° and 200°, yaws 15° and 45°, blocks of
@@ -65,15 +82,10 @@ fn a_block_slides_as_coulomb_says_whatever_the_slopes_dip_direction_and_its_yaw(
             for a in [0.1, 5.0] {
                 for fos in [0.5, 0.95, 1.2] {
                     let label = format!("θ {theta}°, dip dir. {psi}°, yaw {yaw}°, {a} m, F {fos}");
-                    let (text, down, n) = scene_text(theta, psi, yaw, fos, a);
-                    let s = scene::parse(&text, "o.toml", "o").unwrap_or_else(|e| panic!("{e}"));
-                    let mut solver = Solver::new(s.model, s.params);
-                    let start = Vec3::from(solver.snapshot().blocks[1].centroid);
-                    while !solver.finished() {
-                        solver.step().unwrap_or_else(|e| panic!("{label}: {e}"));
-                    }
-                    let d = Vec3::from(solver.snapshot().blocks[1].centroid) - start;
                     let t = theta.to_radians();
+                    let phi = (fos * t.tan()).atan().to_degrees();
+                    let (text, down, n) = scene_text(theta, psi, yaw, phi, (a, a / 2.0));
+                    let d = displacement(&text, &label);
                     let coulomb = 0.5 * 9.8 * (t.sin() - t.cos() * fos * t.tan());
                     if fos >= 1.0 {
                         assert!(d.norm() < 1e-4, "{label}: moved {d:?}");
@@ -99,4 +111,39 @@ fn a_block_slides_as_coulomb_says_whatever_the_slopes_dip_direction_and_its_yaw(
         }
     }
     eprintln!("worst: {:.3} % ({})", 100.0 * worst.0, worst.1);
+}
+
+/// A tall block yawed on its slope topples when the vertical through its centroid leaves its
+/// base: the point (h/2) tan θ down the dip from the base's centre lies outside the b × b square
+/// turned by the yaw, whose edge is (b/2) / max(|cos yaw|, |sin yaw|) away along the dip. So a
+/// block that topples square to the dip may stand yawed 45° (its base reaches √2 farther along
+/// the dip) and topple at 15° (1.035 farther). θ 20–45°, dip directions 0°, 37° and 200°, yaws
+/// 0°, 15°, 30° and 45°, 15 % either side of the limit, friction 80° (no sliding), DDA-3a: moved
+/// more than 10 cm in 1 s where it topples, under 0.1 mm where it stands (measured: at least
+/// 0.21 m, at most 1.2·10⁻⁵ m).
+#[test]
+fn a_yawed_block_topples_when_its_centroid_overhangs_its_turned_base() {
+    for theta in [20.0f64, 30.0, 45.0] {
+        for (psi, yaw) in [(0.0f64, 0.0f64), (37.0, 15.0), (200.0, 30.0), (37.0, 45.0)] {
+            let reach = 0.5
+                / yaw
+                    .to_radians()
+                    .cos()
+                    .abs()
+                    .max(yaw.to_radians().sin().abs());
+            for (ratio, topples) in [(0.85, true), (1.15, false)] {
+                // (h/2) tan θ = reach · b / ratio, with b = 1 m.
+                let h = 2.0 * reach / (ratio * theta.to_radians().tan());
+                let label =
+                    format!("θ {theta}°, dip dir. {psi}°, yaw {yaw}°, {ratio} of the limit");
+                let moved = displacement(&scene_text(theta, psi, yaw, 80.0, (1.0, h)).0, &label);
+                eprintln!("{label}: moved {:.3e} m", moved.norm());
+                if topples {
+                    assert!(moved.norm() > 0.1, "{label}: stood, moved {moved:?}");
+                } else {
+                    assert!(moved.norm() < 1e-4, "{label}: moved {moved:?}");
+                }
+            }
+        }
+    }
 }
