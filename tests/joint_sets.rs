@@ -14,7 +14,7 @@ mod slope_support;
 mod wedge_support;
 
 use slope_support::{first_second, shipped};
-use wedge_support::{G, Run, WedgeCase, rock, run_free_block};
+use wedge_support::{G, OffClosedForm, Run, WedgeCase, rock, run_free_block};
 
 /// One joint set J (dip `dip`, dipping east, friction `phi`) through the origin, and a vertical
 /// release joint R at x = 0, in a 3 m wide slab of rock whose top is 1 m above J and parallel to
@@ -174,17 +174,12 @@ fn hoek_bray_family(method: Method, bounds: Bounds) {
         let label = format!("A {a:?} B {b:?} φ {phi:?}: F = {:.4}", w.factor_of_safety);
         if w.factor_of_safety < 1.0 {
             let d = m.displacement;
-            let angle = d
-                .normalize()
-                .dot(&w.line)
-                .clamp(-1.0, 1.0)
-                .acos()
-                .to_degrees();
-            let error = (m.acceleration - w.acceleration).norm() / w.acceleration.norm();
+            // Along the line: for two-plane sliding a points down the line of intersection.
+            let off = OffClosedForm::of(&m, &w.acceleration, t);
+            let (angle, error) = (off.angle, off.acceleration);
             // The travel from rest, which a late start shortens: ½ a t² along the line.
-            let travel = d.dot(&w.line);
-            let theory = 0.5 * w.acceleration.norm() * t * t;
-            let late = (travel - theory).abs() / theory;
+            let (travel, theory) = (off.travel * off.theory, off.theory);
+            let late = (off.travel - 1.0).abs();
             eprintln!(
                 "{label}: travel {travel:.5} m, theory {theory:.5} m ({:.2} %)",
                 100.0 * late

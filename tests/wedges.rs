@@ -7,7 +7,7 @@ use dda3d::rockmass::wedge::Sliding;
 
 mod wedge_support;
 
-use wedge_support::{Run, WedgeCase, run_free_block};
+use wedge_support::{OffClosedForm, Run, WedgeCase, run_free_block};
 
 /// (set A, set B, slope face, (φ_A, φ_B)): sliding on both planes at F = 0.905, 0.752, 0.376 and
 /// 0.445; on A alone at F = 0.666 and 0.577; standing at F = 1.435 and 1.222.
@@ -65,21 +65,17 @@ fn family(scale: f64, young: f64, run: Run, bounds: &Bounds) -> usize {
         if w.sliding != Sliding::TwoPlanes {
             one_plane += 1;
         }
-        let direction = w.acceleration.normalize();
-        let d = m.displacement;
-        let angle = d
-            .normalize()
-            .dot(&direction)
-            .clamp(-1.0, 1.0)
-            .acos()
-            .to_degrees();
-        let error = (m.acceleration - w.acceleration).norm() / w.acceleration.norm();
-        let travel = d.dot(&direction) / (0.5 * w.acceleration.norm() * run.duration.powi(2));
+        let off = OffClosedForm::of(&m, &w.acceleration, run.duration);
+        let (angle, error, travel) = (off.angle, off.acceleration, off.travel);
         eprintln!(
             "{label}: a off by {:.2} %, travel {travel:.3} of ½ a t², {angle:.2}° off",
             100.0 * error
         );
-        assert!(angle < bounds.angle, "{label}: {angle}° off {direction:?}");
+        assert!(
+            angle < bounds.angle,
+            "{label}: {angle}° off {:?}",
+            w.acceleration
+        );
         assert!(error < bounds.acceleration, "{label}: a off by {error}");
         assert!(
             travel > bounds.travel.0 && travel < bounds.travel.1,

@@ -87,6 +87,41 @@ pub fn run_free_block(text: &str, run: Run, free: impl Fn(&Vec3) -> bool) -> Mot
     }
 }
 
+/// How far a sliding block's run is off a closed form that slides it from rest with the
+/// constant acceleration `a`.
+pub struct OffClosedForm {
+    /// Degrees between the block's displacement and `a`.
+    pub angle: f64,
+    /// |measured − closed-form acceleration| / |a|.
+    pub acceleration: f64,
+    /// The travel along `a` over the closed form's ½ |a| t² at `duration` s (below 1: a late
+    /// start).
+    pub travel: f64,
+    /// ½ |a| t², m.
+    pub theory: f64,
+}
+
+impl OffClosedForm {
+    /// `m`, run for `duration` s from rest, against the closed form's acceleration `a`.
+    pub fn of(m: &Motion, a: &Vec3, duration: f64) -> OffClosedForm {
+        let direction = a.normalize();
+        let angle = m
+            .displacement
+            .normalize()
+            .dot(&direction)
+            .clamp(-1.0, 1.0)
+            .acos()
+            .to_degrees();
+        let theory = 0.5 * a.norm() * duration * duration;
+        OffClosedForm {
+            angle,
+            acceleration: (m.acceleration - a).norm() / a.norm(),
+            travel: m.displacement.dot(&direction) / theory,
+            theory,
+        }
+    }
+}
+
 /// A convex slope domain: the box [−4, 4] × [−3, 6] × [−3, h] times `scale` behind the face
 /// plane through the origin (dip/dip direction `face`), as `vertices` for a region; `h` is the
 /// slope's height, m (already scaled).
