@@ -5,14 +5,7 @@
 use dda3d::params::Method;
 
 mod travel_support;
-use travel_support::{on_slope, travel};
-
-/// The point `s` m off a slope of `theta` degrees (dipping toward +x, as [`on_slope`]) at the
-/// origin's place down the dip, `y` m across it, as a scene's `[x, y, z]`.
-fn beside(theta: f64, s: f64, y: f64) -> String {
-    let t = theta.to_radians();
-    format!("[{:?}, {y:?}, {:?}]", t.sin() * s, t.cos() * s)
-}
+use travel_support::{across_slope, on_slope, travel};
 
 /// An `a` × `w` × `h` block (a along the dip) on a fixed slope of `theta` degrees, 8a + 20 m
 /// long, between two fixed walls touching its sides; tan φ = `fos` tan θ everywhere; rock of
@@ -27,7 +20,7 @@ fn channel(theta: f64, (a, w, h): (f64, f64, f64), fos: f64, young: f64, nu: f64
             "[[blocks]]\nname = \"{name}\"\nmaterial = \"rock\"\nfixed = true\n\
              box = {{ size = [{length}, 1, {}], center = {}, rotation = [0, {theta}, 0] }}\n",
             h + 0.5,
-            beside(theta, (h + 0.5) / 2.0, y)
+            across_slope(theta, (h + 0.5) / 2.0, 0.0, y)
         )
     };
     format!(

@@ -3,10 +3,12 @@
 //! `tests/sliding_accuracy.rs` and `tests/toppling.rs` run slopes dipping toward +x with blocks
 //! square to the dip; here the slope turns about the vertical and the block about its normal.
 
+use dda3d::params::Method;
 use dda3d::physics::geometry::{Mat3, Vec3, box_vertices};
-use dda3d::scene;
-use dda3d::solver::Solver;
 use nalgebra::Rotation3;
+
+mod travel_support;
+use travel_support::displacement;
 
 /// The points as a scene's `vertices`.
 fn points(v: &[Vec3]) -> String {
@@ -55,17 +57,6 @@ fn scene_text(
     (text, down, n)
 }
 
-/// How far the block moved in the 1 s of `text`, m.
-fn displacement(text: &str, label: &str) -> Vec3 {
-    let s = scene::parse(text, "o.toml", "o").unwrap_or_else(|e| panic!("{e}"));
-    let mut solver = Solver::new(s.model, s.params);
-    let start = Vec3::from(solver.snapshot().blocks[1].centroid);
-    while !solver.finished() {
-        solver.step().unwrap_or_else(|e| panic!("{label}: {e}"));
-    }
-    Vec3::from(solver.snapshot().blocks[1].centroid) - start
-}
-
 /// DDA-3a, 1 s from rest, θ 10–60°, dip directions 37° and 200°, yaws 15° and 45°, blocks of
 /// 0.1 and 5 m, F = 0.5 and 0.95: the travel down the dip within 1.5 % of ½ g (sin θ −
 /// cos θ tan φ) t² (measured: 28 of the 36 within 0.1 %; the 5 m blocks at F = 0.95 0.47–1.28 %
@@ -85,7 +76,7 @@ fn a_block_slides_as_coulomb_says_whatever_the_slopes_dip_direction_and_its_yaw(
                     let t = theta.to_radians();
                     let phi = (fos * t.tan()).atan().to_degrees();
                     let (text, down, n) = scene_text(theta, psi, yaw, phi, (a, a / 2.0));
-                    let d = displacement(&text, &label);
+                    let d = Vec3::from(displacement(&text, Method::Alm, None));
                     let coulomb = 0.5 * 9.8 * (t.sin() - t.cos() * fos * t.tan());
                     if fos >= 1.0 {
                         assert!(d.norm() < 1e-4, "{label}: moved {d:?}");
@@ -136,7 +127,11 @@ fn a_yawed_block_topples_when_its_centroid_overhangs_its_turned_base() {
                 let h = 2.0 * reach / (ratio * theta.to_radians().tan());
                 let label =
                     format!("θ {theta}°, dip dir. {psi}°, yaw {yaw}°, {ratio} of the limit");
-                let moved = displacement(&scene_text(theta, psi, yaw, 80.0, (1.0, h)).0, &label);
+                let moved = Vec3::from(displacement(
+                    &scene_text(theta, psi, yaw, 80.0, (1.0, h)).0,
+                    Method::Alm,
+                    None,
+                ));
                 eprintln!("{label}: moved {:.3e} m", moved.norm());
                 if topples {
                     assert!(moved.norm() > 0.1, "{label}: stood, moved {moved:?}");
