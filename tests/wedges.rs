@@ -88,7 +88,7 @@ fn family(scale: f64, young: f64, run: Run, bounds: &Bounds) -> usize {
 /// The family from a 0.6 m to a 20 m slope, at the scene's Δt: the acceleration within 1 %
 /// (2 % on the 20 m slope), the direction within 1°. The travel from rest: within 10 % of
 /// ½ a t² up to 6 m (measured: −6.6 % to +0.7 %; the shortfall of a start about half a step
-/// late), and up to 20 % long on the 20 m slope, whose wedge of 3·10⁶ kg sinks into its
+/// late), and up to 20 % long on the 20 m slope, whose wedge of 2.4·10⁶ kg sinks into its
 /// contacts as gravity is switched on and takes a kick from them in its first step (+14.8 %
 /// at F = 0.905; the equilibrium stage is for that). A standing wedge settles into its contacts
 /// by what its weight over their stiffness gives, which grows as the scale squared: under
@@ -111,7 +111,7 @@ fn wedges_from_half_a_metre_to_twenty_metres_slide_as_hoek_bray_says() {
     }
 }
 
-/// Light wedges (on slopes of 10 to 40 cm: wedges of about 0.2 to 13 kg) in rock of 1 and
+/// Light wedges (on slopes of 10 to 40 cm: wedges of 0.2 to 58 kg) in rock of 1 and
 /// 10 GPa, at Δt = 2 ms. (At the default 10 ms their first steps can take every open–close pass
 /// and settle stuck: a third of these wedges then start a step or more late, five of the 36
 /// three to six steps.) They slide, none hung from the tension crack behind them: while a
