@@ -553,9 +553,15 @@ fn execute(case: &Case, dir: &Path, timeout: Duration) -> Run {
 /// A failure: its kind and the details.
 type Verdict = Result<(), (&'static str, String)>;
 
-/// A non-zero status's stderr: one non-empty line, `error: …`.
+/// A non-zero status's stderr: one non-empty line, `error: …`, after any warnings the run gave
+/// on its way (`FILE: warning: …`, one line each: an equilibrium stage that did not converge,
+/// then a load of 10³⁰⁰ N made the first step's solution infinite; seed 777001, case 5457).
 fn one_line(stderr: &str) -> Verdict {
     let s = stderr.strip_suffix('\n').unwrap_or(stderr);
+    let s = match s.rsplit_once('\n') {
+        Some((warnings, last)) if warnings.split('\n').all(|l| l.contains(": warning: ")) => last,
+        _ => s,
+    };
     match s.split('\n').count() {
         _ if s.is_empty() => Err(("no error message", String::new())),
         1 if s.starts_with("error:") => Ok(()),

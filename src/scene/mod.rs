@@ -16,7 +16,7 @@
 //! vertices = [[0,0,0], ...]           # or box = {...}, dodecahedron = {...}, prism = {...}
 //! ```
 //!
-//! - [`format`]: the TOML tables as serde reads them;
+//! - [`format`]: the TOML tables as serde reads them; [`tables`]: no list where they are tables;
 //! - [`build`]: materials checked, shapes turned into blocks, the start checked for overlaps;
 //! - [`locate`]: the line and key of an error, found in the text.
 //!
@@ -29,6 +29,7 @@ mod format;
 mod locate;
 mod read;
 mod rock_mass;
+mod tables;
 mod write;
 
 use std::fmt;
@@ -244,6 +245,7 @@ fn parse_cut(
         let (line, message) = toml_error(text, &e);
         err(line, message)
     })?;
+    tables::check(text).map_err(|(line, m)| err(Some(line), m))?;
     let mut params = file.solver.clone();
     params.joint = file.joint.clone();
     params
