@@ -219,6 +219,7 @@ fn activate_one(
         flips: 0,
         frozen: false,
         stopped: false,
+        onset_slip: 0.0,
         stop_fraction: None,
         changed: false,
         shear: Vec3::zeros(),

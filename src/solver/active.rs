@@ -80,6 +80,10 @@ pub(crate) struct Active {
     pub frozen: bool,
     /// Stopped by the contact law in this attempt ([`law::Observation::restarted`]).
     pub stopped: bool,
+    /// The slip expected over the step of a contact that began to slide from rest in this
+    /// attempt, m: its k⊥ is taken over no less (`crate::solver::open_close`, `onset_slip`); 0
+    /// otherwise.
+    pub onset_slip: f64,
     /// The share of Δt at which this contact's sliding stopped, where its slip reversed within
     /// the attempt while it was sliding fast ([`super::step_control::stop_within`]).
     pub stop_fraction: Option<f64>,

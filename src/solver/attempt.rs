@@ -108,6 +108,7 @@ fn open_close_iteration(
         c.flips = 0;
         c.frozen = false;
         c.stopped = false;
+        c.onset_slip = 0.0;
         c.stop_fraction = None;
         c.release_overlap(inp.dt);
         c.predict_lateral(p, inp.blocks, inp.dt);
