@@ -35,20 +35,25 @@ struct Bounds {
     stands: f64,
 }
 
+/// A case of [`CASES`] at `scale` (a slope 2·scale m high) in rock of `young` Pa.
+fn wedge_case((a, b, face, phi): (Pair, Pair, Pair, Pair), scale: f64, young: f64) -> WedgeCase {
+    WedgeCase {
+        a,
+        b,
+        face,
+        phi,
+        scale,
+        young,
+    }
+}
+
 /// Every case of [`CASES`] at `scale` (a slope 2·scale m high) in rock of `young` Pa, run for
 /// `run.duration` s; panics with the case where one is off by more than `bounds`. Returns the
 /// number of wedges that slid on one plane (the family must have some).
 fn family(scale: f64, young: f64, run: Run, bounds: &Bounds) -> usize {
     let mut one_plane = 0;
     for (a, b, face, phi) in CASES {
-        let case = WedgeCase {
-            a,
-            b,
-            face,
-            phi,
-            scale,
-            young,
-        };
+        let case = wedge_case((a, b, face, phi), scale, young);
         let w = case.solution();
         let (text, free) = case.scene();
         let m = run_free_block(&text, run, free);
@@ -156,14 +161,7 @@ fn light_wedges_start_on_time_at_the_default_time_step() {
     for scale in [0.05, 0.1, 0.2] {
         for young in [1e9, 1e10] {
             for (a, b, face, phi) in CASES {
-                let case = WedgeCase {
-                    a,
-                    b,
-                    face,
-                    phi,
-                    scale,
-                    young,
-                };
+                let case = wedge_case((a, b, face, phi), scale, young);
                 let w = case.solution();
                 if w.factor_of_safety >= 1.0 {
                     continue;
