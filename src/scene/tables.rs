@@ -3,7 +3,7 @@
 //! `rock = [2750.0, 2.0e10, 0.25]` under `[materials]` a material by the order of its keys, and
 //! `box = [[1, 1, 1], [0, 0, 5]]` a box, all silently (found by `tests/fuzz_scenes.rs` with
 //! another seed). The format's tables are listed here, and [`check`] walks the text's tables
-//! against the list before serde reads it.
+//! against the list once serde has read it (toml's span-keeping parse, for the line).
 
 use toml::de::{DeTable, DeValue};
 
@@ -85,10 +85,16 @@ fn walk(table: &DeTable<'_>, shape: &[(&str, Shape)], prefix: &str) -> Result<()
                     match item.get_ref() {
                         DeValue::Table(t) => walk(t, keys, &format!("{path}[{k}]."))?,
                         _ => {
+                            // A header names the list without the entries' indices.
+                            let header: String = path
+                                .split('.')
+                                .map(|k| k.split('[').next().unwrap_or(k))
+                                .collect::<Vec<_>>()
+                                .join(".");
                             return Err((
                                 item.span().start,
                                 format!(
-                                    "{path}: each entry must be a table ([[{path}]] or {{ key = value, ... }})"
+                                    "{path}: each entry must be a table ([[{header}]] or {{ key = value, ... }})"
                                 ),
                             ));
                         }
@@ -137,6 +143,7 @@ mod tests {
         assert!(m.starts_with("blocks[0].box must be a table"), "{m}");
         let (_, m) = refused("[[blocks]]\nmaterial = \"r\"\nloads = [[[0, 0, 0], [1, 0, 0]]]\n");
         assert!(m.starts_with("blocks[0].loads: each entry"), "{m}");
+        assert!(m.contains("([[blocks.loads]] or"), "{m}");
         let (_, m) = refused("joint = []\n");
         assert!(m.starts_with("joint must be a table"), "{m}");
         let (_, m) = refused("blocks = [[1, 2, 3]]\n");

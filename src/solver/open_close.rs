@@ -456,15 +456,14 @@ fn apply(inp: &CheckInputs, c: &mut Active, verdict: Transition, shear: Vec3) {
     // locked has next to none: it starts as stiff across τ as its spring was), or, in the step
     // a light contact began to slide from rest, the slip it is expected to make ([`onset_slip`]).
     if c.rec.state == ContactState::Slide {
-        if matches!(verdict, Transition::Slide { .. }) && inp.onset_turns && softens(inp, c) {
+        let onset = matches!(verdict, Transition::Slide { .. })
+            && c.start.state != ContactState::Slide
+            && inp.onset_turns
+            && softens(inp, c);
+        if onset {
             c.onset_slip = c.onset_slip.max(onset_slip(inp, c, &shear));
         }
-        let slip = if c.start.state == ContactState::Slide {
-            c.slip.norm()
-        } else {
-            c.slip.norm().max(c.onset_slip)
-        };
-        c.set_lateral(inp.params, slip);
+        c.set_lateral(inp.params, c.slip.norm().max(c.onset_slip));
     }
 }
 
